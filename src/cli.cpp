@@ -1,0 +1,4 @@
+#include "cli.h"
+namespace bl {
+int run_cli(int, char**) { return 1; }
+}  // namespace bl

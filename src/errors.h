@@ -1,0 +1,37 @@
+// errors: the two failure kinds users see, each with its exit status (SPEC.md section 4).
+// input_error (exit 3): a missing, unreadable or malformed scene, OBJ, MTL or image; names file and line.
+// usage_error (exit 2): a bad command line. output_error and anything else escaping main is exit 1.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace bl {
+
+constexpr int exit_ok = 0;
+constexpr int exit_failure = 1;
+constexpr int exit_usage = 2;
+constexpr int exit_bad_input = 3;
+
+// Bad input file: the message reads "FILE:LINE: what" (or "FILE: what" when there is no line).
+struct input_error : std::runtime_error {
+  std::string file;
+  int line = 0;
+  input_error(const std::string& file_, int line_, const std::string& what)
+      : std::runtime_error(file_ + (line_ > 0 ? ":" + std::to_string(line_) : std::string()) + ": " + what),
+        file(file_),
+        line(line_) {}
+  input_error(const std::string& file_, const std::string& what) : input_error(file_, 0, what) {}
+};
+
+// Output could not be written (unwritable path, full disk): exit 1.
+struct output_error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Bad command line (unknown flag, value out of range, unknown sampler name).
+struct usage_error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace bl

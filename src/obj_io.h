@@ -1,0 +1,45 @@
+// obj_io: reads a Wavefront OBJ and its MTL files into flat arrays (tinyobjloader underneath).
+// Invariants: every returned triangle has finite vertices and non-zero area (degenerate ones are dropped and
+// counted); every index is valid; polygons are triangulated. Malformed input throws input_error naming the
+// file and, where there is one, the line.
+#pragma once
+
+#include "math.h"
+#include "texture.h"
+
+#include <string>
+#include <vector>
+
+namespace bl {
+
+// One OBJ material (MTL statement names in comments). Colours are linear RGB.
+struct material_data {
+  std::string name;
+  vec3f kd = {0.8f, 0.8f, 0.8f};  // Kd diffuse albedo
+  vec3f ks = {0, 0, 0};           // Ks specular albedo of the normalized Phong lobe
+  float ns = 1;                   // Ns Phong exponent (>= 0)
+  vec3f ke = {0, 0, 0};           // Ke emitted radiance (non-zero: the triangle is an area light)
+  int kd_texture = invalid_id;    // map_Kd: index into mesh_data::textures
+  int alpha_texture = invalid_id; // map_d: index into mesh_data::textures
+};
+
+// A triangle mesh as flat columns; corner c of triangle t is entry 3*t+c of the tri_* corner arrays.
+struct mesh_data {
+  std::vector<vec3f> positions;
+  std::vector<vec3f> normals;     // `vn`, unit length
+  std::vector<vec2f> texcoords;   // `vt`
+  std::vector<int> tri_positions; // 3 per triangle: indices into positions
+  std::vector<int> tri_normals;   // 3 per triangle: indices into normals, or invalid_id
+  std::vector<int> tri_texcoords; // 3 per triangle: indices into texcoords, or invalid_id
+  std::vector<int> tri_materials; // 1 per triangle: index into materials
+  std::vector<material_data> materials;
+  std::vector<texture_data> textures;
+  int dropped_degenerate = 0;     // zero-area triangles removed on load
+};
+
+inline int triangle_count(const mesh_data& m) { return int(m.tri_materials.size()); }
+
+// Loads an OBJ file with its MTL libraries and textures (paths relative to the OBJ's directory).
+mesh_data load_obj(const std::string& path);
+
+}  // namespace bl

@@ -1,0 +1,58 @@
+// rng: every random number of a render, keyed by (seed, pixel, sample, path vertex, dimension).
+// Invariants: a (pixel, sample) pair owns one PCG32 key; each path vertex draws its own fixed-size block of
+// uniforms from the PCG32 stream numbered by the vertex, in the fixed order of the dimension table below.
+// So changing the light sampler (which uses only the light dimensions) leaves camera rays and BSDF samples
+// untouched, and no random number depends on thread identity or timing.
+#pragma once
+
+#include <pcg_random.hpp>
+
+#include <cstdint>
+
+namespace bl {
+
+// The dimension table: slots of one vertex's random block. Vertex 0 is the camera (pixel jitter).
+enum rng_dim : int {
+  dim_pixel_x = 0,       // camera vertex: jitter inside the pixel
+  dim_pixel_y = 1,       //
+  dim_light_select = 0,  // path vertices: which light / cluster
+  dim_light_inner = 1,   // second-level choice inside a cluster (tree descent)
+  dim_light_u = 2,       // point on the chosen light
+  dim_light_v = 3,       //
+  dim_bsdf_lobe = 4,     // diffuse or glossy lobe
+  dim_bsdf_u = 5,        // direction inside the lobe
+  dim_bsdf_v = 6,        //
+  dim_roulette = 7,      // Russian roulette
+  dims_per_vertex = 8
+};
+
+// One vertex's uniforms in [0, 1).
+struct vertex_randoms {
+  float u[dims_per_vertex];
+};
+
+// 64-bit finaliser (splitmix64): decorrelates nearby keys.
+inline uint64_t mix64(uint64_t z) {
+  z += 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+// The PCG32 key of sample `sample` of pixel `pixel` under render seed `seed`.
+inline uint64_t sample_key(uint64_t seed, uint64_t pixel, uint64_t sample) {
+  return mix64(mix64(mix64(seed) ^ pixel) ^ (sample * 0x632be59bd9b4e019ull));
+}
+
+// Uniform float in [0, 1) from the top 24 bits of a 32-bit draw (exactly representable).
+inline float uint_to_unit(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
+
+// The block of uniforms of path vertex `vertex` (0 = camera) of the sample with key `key`.
+inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex) {
+  pcg32 rng(key, vertex);
+  vertex_randoms r;
+  for (int i = 0; i < dims_per_vertex; i++) r.u[i] = uint_to_unit(rng());
+  return r;
+}
+
+}  // namespace bl
