@@ -28,7 +28,7 @@ TEST_CASE("vertex blocks repeat for the same key and differ between keys and ver
   CHECK(firsts.size() > 4080);
 }
 
-TEST_CASE("uniforms are in [0, 1) and the mean is 1/2", "[rng]") {
+TEST_CASE("uniforms lie in the unit interval with mean one half", "[rng]") {
   // 80000 uniforms: the mean's standard error is 0.289/sqrt(80000) = 0.00102; 5 sigma bound.
   double sum = 0;
   int n = 0;
