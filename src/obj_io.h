@@ -1,7 +1,8 @@
-// obj_io: reads a Wavefront OBJ and its MTL files into flat arrays (tinyobjloader underneath).
-// Invariants: every returned triangle has finite vertices and non-zero area (degenerate ones are dropped and
-// counted); every index is valid; polygons are triangulated. Malformed input throws input_error naming the
-// file and, where there is one, the line.
+// obj_io: reads a Wavefront OBJ and its MTL files into flat arrays (validated first, tinyobjloader underneath).
+// Invariants: every returned triangle has finite vertices and non-zero float area (degenerate ones are dropped
+// and counted); every index is valid; polygons are triangulated keeping their winding; triangles are in file
+// order and the vertex arrays hold only referenced elements, in file order. Malformed input throws input_error
+// naming the file and, where there is one, the line; the result never depends on hash or pointer order.
 #pragma once
 
 #include "math.h"
@@ -12,7 +13,8 @@
 
 namespace bl {
 
-// One OBJ material (MTL statement names in comments). Colours are linear RGB.
+// One OBJ material (MTL statement names in comments). Colours are linear RGB; a statement the MTL omits keeps
+// the default below.
 struct material_data {
   std::string name;
   vec3f kd = {0.8f, 0.8f, 0.8f};  // Kd diffuse albedo
@@ -24,9 +26,11 @@ struct material_data {
 };
 
 // A triangle mesh as flat columns; corner c of triangle t is entry 3*t+c of the tri_* corner arrays.
+// materials: those named by usemtl, in order of first use, then one named "default" (Kd 0.8) when some face
+// came before any usemtl. textures: one per distinct resolved path, in order of first reference.
 struct mesh_data {
   std::vector<vec3f> positions;
-  std::vector<vec3f> normals;     // `vn`, unit length
+  std::vector<vec3f> normals;     // `vn`, unit length (a zero-length vn leaves its corners without one)
   std::vector<vec2f> texcoords;   // `vt`
   std::vector<int> tri_positions; // 3 per triangle: indices into positions
   std::vector<int> tri_normals;   // 3 per triangle: indices into normals, or invalid_id
@@ -34,12 +38,13 @@ struct mesh_data {
   std::vector<int> tri_materials; // 1 per triangle: index into materials
   std::vector<material_data> materials;
   std::vector<texture_data> textures;
-  int dropped_degenerate = 0;     // zero-area triangles removed on load
+  int dropped_degenerate = 0;     // zero-area or non-finite triangles removed on load
 };
 
 inline int triangle_count(const mesh_data& m) { return int(m.tri_materials.size()); }
 
-// Loads an OBJ file with its MTL libraries and textures (paths relative to the OBJ's directory).
+// Loads an OBJ file with its MTL libraries (relative to the OBJ's folder) and the map_Kd / map_d textures of
+// the materials it uses (relative to their MTL's folder). Unrecognised statements are reported on stderr.
 mesh_data load_obj(const std::string& path);
 
 }  // namespace bl

@@ -1,0 +1,51 @@
+// bayes_sampler: posterior cluster weights per shading point, observation recording, learning between passes.
+#include "bayes_sampler.h"
+
+namespace bl {
+
+void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
+  locate_region(ctx, regions, sp);
+  size_t base = size_t(regions.pair_offset[size_t(ctx.region)]);
+  // Prior scale: a Lambertian point of albedo a turns irradiance E into radiance a E / pi.
+  double scale = (sp.albedo > 0 ? sp.albedo : 1.0f) * inv_pi_f;
+  double w[max_cut_entries], b[max_cut_entries];
+  double sum_w = 0, sum_b = 0;
+  for (int j = 0; j < ctx.count; j++) {
+    int node = ctx.nodes[j];
+    float bound = cluster_bound(*tree, *lights, node, sp.p, sp.n, sun_sin, sun_cos);
+    float d = params.distance_regression ? cluster_distance(*tree, node, sp.p) : 1.0f;
+    size_t i = base + size_t(j);
+    w[j] = posterior_weight(params, bound, scale, d, stats.n0[i], stats.n1[i], stats.mean[i], stats.m2[i]);
+    b[j] = bound;
+    sum_w += w[j];
+    sum_b += b[j];
+  }
+  // Defensive mixing with the bound pmf (always a little for the naive ablation, which can starve clusters).
+  double eps = params.prior ? params.epsilon : std::max(params.epsilon, 1e-3);
+  if (eps > 0 && sum_w > 0 && sum_b > 0)
+    for (int j = 0; j < ctx.count; j++) w[j] = (1 - eps) * w[j] / sum_w + eps * b[j] / sum_b;
+  finish_cdf(ctx, w);
+}
+
+void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
+  const cut_context& ctx = *e.context;
+  row.requests.add(regions, ctx);
+  int j = e.choice.cluster;
+  if (j < 0) return;
+  double z = e.value;
+  if (z > 0 && params.distance_regression) {
+    double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
+    z *= d * d;
+  }
+  row.add(regions.pair_offset[size_t(ctx.region)] + j, z);
+}
+
+void bayes_sampler::learn(std::vector<row_state>& rows) {
+  merge_rows(stats, rows);
+  std::vector<const region_requests*> r;
+  for (const row_state& row : rows) r.push_back(&row.requests);
+  create_requested_regions(regions, *tree, r);
+  resize_stats(stats, regions.pairs);
+}
+
+}  // namespace bl

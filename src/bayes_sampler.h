@@ -1,0 +1,36 @@
+// bayes_sampler: the paper's method — Bayesian online regression of each (region, cluster) pair's
+// contribution, with the bound as prior; clusters are chosen proportionally to the posterior estimate of the
+// square root of their second moment, sqrt((1 - p0)(k^2 + h)) / d^2, optionally mixed with the bound pmf.
+// Invariants: during a pass the statistics are frozen (read-only); between passes the rows' observations are
+// folded in image order and requested regions are created, so images are identical for any thread count.
+#pragma once
+
+#include "bayes_stats.h"
+#include "cut_sampling.h"
+
+#include <vector>
+
+namespace bl {
+
+// The Bayesian sampler; owns its regions and statistics, reads a light tree it does not own.
+struct bayes_sampler {
+  static constexpr bool learns = true;
+  using context = cut_context;
+  using row_state = bayes_row;
+  const light_tree_data* tree = nullptr;
+  const light_data* lights = nullptr;
+  region_state regions;
+  bayes_stats stats;
+  bayes_params params;
+  float sun_sin = 0, sun_cos = 1;
+
+  void prepare(context& ctx, const shade_point& sp) const;
+  light_choice sample(const context& ctx, float u, float u_inner) const {
+    return sample_cut(ctx, *tree, *lights, u, u_inner);
+  }
+  float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
+  void record(row_state& row, const nee_event<context>& e) const;
+  void learn(std::vector<row_state>& rows);
+};
+
+}  // namespace bl

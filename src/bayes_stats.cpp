@@ -1,0 +1,102 @@
+// bayes_stats: accumulation, merging and the conjugate posterior.
+#include "bayes_stats.h"
+
+#include "rng.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace bl {
+
+void resize_stats(bayes_stats& s, int64_t pairs) {
+  size_t n = size_t(pairs);
+  s.n0.resize(n, 0.0);
+  s.n1.resize(n, 0.0);
+  s.mean.resize(n, 0.0);
+  s.m2.resize(n, 0.0);
+}
+
+void decay_stats(bayes_stats& s, double gamma) {
+  for (size_t i = 0; i < s.n0.size(); i++) {
+    s.n0[i] *= gamma;
+    s.n1[i] *= gamma;
+    s.m2[i] *= gamma;  // the mean is unchanged by scaling all weights
+  }
+}
+
+void bayes_row::clear() {
+  requests.clear();
+  std::fill(slots.begin(), slots.end(), -1);
+  acc.clear();
+}
+
+void bayes_row::add(int pair, double z) {
+  if (2 * (acc.size() + 1) > slots.size()) {
+    // Grow and rehash (load <= 1/2).
+    size_t n = std::max<size_t>(64, slots.size() * 2);
+    slots.assign(n, -1);
+    for (size_t i = 0; i < acc.size(); i++) {
+      size_t h = size_t(mix64(uint64_t(acc[i].pair))) & (n - 1);
+      while (slots[h] >= 0) h = (h + 1) & (n - 1);
+      slots[h] = int(i);
+    }
+  }
+  size_t mask = slots.size() - 1;
+  size_t h = size_t(mix64(uint64_t(pair))) & mask;
+  while (slots[h] >= 0 && acc[size_t(slots[h])].pair != pair) h = (h + 1) & mask;
+  if (slots[h] < 0) {
+    slots[h] = int(acc.size());
+    acc.push_back({pair, 0, 0, 0, 0});
+  }
+  pair_accum& a = acc[size_t(slots[h])];
+  if (z == 0) {
+    a.n0 += 1;
+    return;
+  }
+  a.n1 += 1;
+  double delta = z - a.mean;
+  a.mean += delta / a.n1;
+  a.m2 += delta * (z - a.mean);
+}
+
+void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows) {
+  for (const bayes_row& row : rows)
+    for (const pair_accum& a : row.acc) {
+      size_t i = size_t(a.pair);
+      s.n0[i] += a.n0;
+      if (a.n1 == 0) continue;
+      double n = s.n1[i] + a.n1;
+      double delta = a.mean - s.mean[i];
+      s.mean[i] += delta * (a.n1 / n);
+      s.m2[i] += a.m2 + delta * delta * (s.n1[i] * a.n1 / n);
+      s.n1[i] = n;
+    }
+}
+
+double posterior_weight(const bayes_params& p, double bound, double scale, double d, double n0, double n1,
+                        double mean, double m2) {
+  if (!(bound > 0)) return 0;
+  double d2 = d * d;
+  double mu0 = scale * bound * d2;
+  if (!p.prior) {
+    // Naive plug-in estimates; a cluster without samples follows its bound.
+    double n = n0 + n1;
+    if (n == 0) return mu0 / d2;
+    double p0 = n0 / n;
+    double h = n1 >= 2 ? m2 / n1 : 0.0;
+    if (!p.second_moment) return (1 - p0) * mean / d2;
+    return std::sqrt((1 - p0) * (mean * mean + h)) / d2;
+  }
+  double p0 = (p.a0 + n0) / (p.a0 + p.b0 + n0 + n1);
+  double kn = p.kappa0 + n1;
+  double mun = (p.kappa0 * mu0 + n1 * mean) / kn;
+  if (!p.second_moment) return (1 - p0) * mun / d2;
+  double an = p.alpha0 + 0.5 * n1;
+  double beta0 = p.c * mu0 * mu0 * (p.alpha0 - 1);
+  double dm = mean - mu0;
+  double bn = beta0 + 0.5 * (m2 + p.kappa0 * n1 * dm * dm / kn);
+  double h = bn / (an - 1);
+  return std::sqrt((1 - p0) * (mun * mun + h)) / d2;
+}
+
+}  // namespace bl

@@ -1,0 +1,171 @@
+// bvh: Embree 3 device/scene set-up (Embree-owned buffers), queries, and the alpha cut-out filter.
+#include "bvh.h"
+
+#include "errors.h"
+#include "texture.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace bl {
+
+namespace {
+
+// Embree reports errors through this callback; the message is rethrown after the failing call.
+void embree_error(void* user, RTCError code, const char* str) {
+  auto* msg = static_cast<std::string*>(user);
+  if (msg->empty()) *msg = "Embree error " + std::to_string(int(code)) + ": " + (str ? str : "");
+}
+
+// Rejects hits on transparent texels of map_d materials (alpha < 0.5), with our own barycentrics.
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* scene = static_cast<const scene_data*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; i++) {
+    if (args->valid[i] != -1) continue;
+    unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    int material = scene->mesh.tri_materials[prim];
+    int tex = scene->mesh.materials[material].alpha_texture;
+    if (tex == invalid_id) continue;
+    vec3f org = {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                 RTCRayN_org_z(args->ray, args->N, i)};
+    vec3f dir = {RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                 RTCRayN_dir_z(args->ray, args->N, i)};
+    hit_info h = intersect_triangle(*scene, int(prim), org, dir);
+    surface_point sp = eval_surface(*scene, int(prim), h.b1, h.b2, dir);
+    if (eval_texture_alpha(scene->mesh.textures[tex], sp.uv) < 0.5f) args->valid[i] = 0;
+  }
+}
+
+}  // namespace
+
+bvh_data& bvh_data::operator=(bvh_data&& o) noexcept {
+  std::swap(device, o.device);
+  std::swap(scene, o.scene);
+  std::swap(source, o.source);
+  return *this;
+}
+
+bvh_data::~bvh_data() {
+  if (scene) rtcReleaseScene(scene);
+  if (device) rtcReleaseDevice(device);
+}
+
+bvh_data build_bvh(const scene_data& s) {
+  bvh_data b;
+  b.source = &s;
+  // Default device config: thread count stays TBB's (a "threads=" setting would cap the whole process).
+  b.device = rtcNewDevice(nullptr);
+  if (!b.device) throw std::runtime_error("cannot create the Embree device (error " +
+                                          std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+  std::string error;
+  rtcSetDeviceErrorFunction(b.device, embree_error, &error);
+  b.scene = rtcNewScene(b.device);
+  rtcSetSceneBuildQuality(b.scene, RTC_BUILD_QUALITY_MEDIUM);
+  const mesh_data& m = s.mesh;
+  int n = triangle_count(m);
+  if (n > 0) {
+    RTCGeometry geom = rtcNewGeometry(b.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                           3 * sizeof(float), m.positions.size()));
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n));
+    if (!vb || !ib) throw std::runtime_error("Embree could not allocate geometry buffers: " + error);
+    for (size_t i = 0; i < m.positions.size(); i++) {
+      vb[3 * i + 0] = m.positions[i].x;
+      vb[3 * i + 1] = m.positions[i].y;
+      vb[3 * i + 2] = m.positions[i].z;
+    }
+    for (size_t i = 0; i < size_t(3) * n; i++) ib[i] = unsigned(m.tri_positions[i]);
+    if (s.has_alpha) {
+      rtcSetGeometryUserData(geom, const_cast<scene_data*>(&s));
+      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(b.scene, geom);
+    rtcReleaseGeometry(geom);
+  }
+  rtcCommitScene(b.scene);
+  if (!error.empty()) throw std::runtime_error(error);
+  rtcSetDeviceErrorFunction(b.device, nullptr, nullptr);
+  return b;
+}
+
+hit_info intersect_triangle(const scene_data& s, int tri, vec3f org, vec3f dir) {
+  vec3f e1 = s.tri_e1[tri], e2 = s.tri_e2[tri];
+  vec3f pvec = cross(dir, e2);
+  float det = dot(e1, pvec);
+  hit_info h;
+  h.tri = tri;
+  if (det == 0 || !std::isfinite(det)) {
+    // Ray in the triangle's plane (Embree still reported a hit): take the centroid at its projection.
+    vec3f c = s.tri_p0[tri] + (e1 + e2) * (1.0f / 3.0f);
+    h.t = std::max(0.0f, dot(c - org, dir));
+    h.b1 = h.b2 = 1.0f / 3.0f;
+    return h;
+  }
+  float inv = 1.0f / det;
+  vec3f tvec = org - s.tri_p0[tri];
+  float b1 = dot(tvec, pvec) * inv;
+  vec3f qvec = cross(tvec, e1);
+  float b2 = dot(dir, qvec) * inv;
+  float t = dot(e2, qvec) * inv;
+  // Clamp onto the triangle: Embree's watertight test may accept hits our float test puts just outside.
+  b1 = std::max(b1, 0.0f);
+  b2 = std::max(b2, 0.0f);
+  float sum = b1 + b2;
+  if (sum > 1) {
+    b1 /= sum;
+    b2 /= sum;
+  }
+  h.t = std::max(t, 0.0f);
+  h.b1 = b1;
+  h.b2 = b2;
+  return h;
+}
+
+hit_info intersect(const bvh_data& b, vec3f org, vec3f dir, float tmax) {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh;
+  rh.ray.org_x = org.x;
+  rh.ray.org_y = org.y;
+  rh.ray.org_z = org.z;
+  rh.ray.tnear = 0;
+  rh.ray.dir_x = dir.x;
+  rh.ray.dir_y = dir.y;
+  rh.ray.dir_z = dir.z;
+  rh.ray.time = 0;
+  rh.ray.tfar = tmax;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(b.scene, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
+  return intersect_triangle(*b.source, int(rh.hit.primID), org, dir);
+}
+
+bool occluded(const bvh_data& b, vec3f org, vec3f dir, float tmax) {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRay r;
+  r.org_x = org.x;
+  r.org_y = org.y;
+  r.org_z = org.z;
+  r.tnear = 0;
+  r.dir_x = dir.x;
+  r.dir_y = dir.y;
+  r.dir_z = dir.z;
+  r.time = 0;
+  r.tfar = tmax;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+  rtcOccluded1(b.scene, &ctx, &r);
+  return r.tfar < 0;  // Embree sets tfar to -inf when the segment is blocked
+}
+
+}  // namespace bl

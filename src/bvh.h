@@ -1,0 +1,44 @@
+// bvh: owns the Embree 3 device and scene; answers closest-hit and occlusion queries.
+// Invariants: only hit/miss and the primitive id come from Embree (they are identical on every x86-64 CPU);
+// distance and barycentrics are recomputed by `intersect_triangle` in our own float code, also inside the
+// alpha cut-out filter, so images never depend on Embree's ISA-specific arithmetic.
+#pragma once
+
+#include "math.h"
+#include "scene.h"
+
+#include <embree3/rtcore.h>
+
+namespace bl {
+
+// The Embree device and scene of one scene_data (move-only; releases both on destruction).
+struct bvh_data {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  const scene_data* source = nullptr;
+  bvh_data() = default;
+  bvh_data(const bvh_data&) = delete;
+  bvh_data& operator=(const bvh_data&) = delete;
+  bvh_data(bvh_data&& o) noexcept { *this = std::move(o); }
+  bvh_data& operator=(bvh_data&& o) noexcept;
+  ~bvh_data();
+};
+
+// Builds the acceleration structure; `scene` must outlive the result (the alpha filter reads it).
+bvh_data build_bvh(const scene_data& scene);
+
+// A closest hit: triangle, distance along the (unit) ray direction and barycentrics of corners 1 and 2.
+struct hit_info {
+  int tri = invalid_id;
+  float t = 0, b1 = 0, b2 = 0;
+};
+
+// Closest hit of the ray org + t*dir, t in (0, tmax); tri == invalid_id on a miss.
+hit_info intersect(const bvh_data& bvh, vec3f org, vec3f dir, float tmax = inf_f);
+// Whether anything blocks the segment org + t*dir, t in (0, tmax).
+bool occluded(const bvh_data& bvh, vec3f org, vec3f dir, float tmax);
+
+// Our own ray/triangle distance and barycentrics (Moller-Trumbore in float), clamped onto the triangle.
+hit_info intersect_triangle(const scene_data& scene, int tri, vec3f org, vec3f dir);
+
+}  // namespace bl

@@ -1,0 +1,64 @@
+// bvh_sampler: importance-driven tree descent and its exact pmf.
+#include "bvh_sampler.h"
+
+namespace bl {
+
+float sun_importance(const light_data& lights, vec3f n, float sun_sin, float sun_cos) {
+  if (lights.sun == invalid_id) return 0;
+  return luminance(lights.sun_irradiance) * receiver_cos_bound(n, lights.sun_dir, sun_sin, sun_cos);
+}
+
+void bvh_sampler::prepare(context& ctx, const shade_point& sp) const {
+  ctx.p = sp.p;
+  ctx.n = sp.n;
+  float is = sun_importance(*lights, sp.n, sun_sin, sun_cos);
+  float it = node_count(*tree) > 0 ? node_importance(*tree, 0, sp.p, sp.n) : 0.0f;
+  float total = is + it;
+  ctx.p_sun = total > 0 ? is / total : 0.0f;
+  ctx.p_tree = total > 0 ? (is > 0 ? 1 - ctx.p_sun : 1.0f) : 0.0f;
+}
+
+light_choice bvh_sampler::sample(const context& ctx, float u, float) const {
+  if (ctx.p_sun > 0 && u < ctx.p_sun) return {lights->sun, ctx.p_sun};
+  if (!(ctx.p_tree > 0)) return {};
+  u = std::min((u - ctx.p_sun) / ctx.p_tree, 0x1.fffffep-1f);
+  float prob = ctx.p_tree;
+  int node = 0;
+  while (!is_leaf(*tree, node)) {
+    int l = tree->left[size_t(node)], r = tree->right[size_t(node)];
+    float il = node_importance(*tree, l, ctx.p, ctx.n), ir = node_importance(*tree, r, ctx.p, ctx.n);
+    if (!(il + ir > 0)) return {};
+    float pl = il / (il + ir);
+    if (u < pl) {
+      u = std::min(u / pl, 0x1.fffffep-1f);
+      prob *= pl;
+      node = l;
+    } else {
+      u = std::min((u - pl) / (1 - pl), 0x1.fffffep-1f);
+      prob *= 1 - pl;
+      node = r;
+    }
+  }
+  if (!(prob > 0)) return {};
+  return {tree->light[size_t(node)], prob};
+}
+
+float bvh_sampler::pmf(const context& ctx, int light) const {
+  if (light == lights->sun) return ctx.p_sun;
+  if (!(ctx.p_tree > 0)) return 0;
+  int path[max_tree_depth + 1];
+  int len = 0;
+  for (int n = tree->leaf_of_light[size_t(light)]; n != 0; n = tree->parent[size_t(n)]) path[len++] = n;
+  float prob = ctx.p_tree;
+  for (int k = len - 1; k >= 0; k--) {
+    int child = path[k], parent = tree->parent[size_t(child)];
+    int l = tree->left[size_t(parent)], r = tree->right[size_t(parent)];
+    float il = node_importance(*tree, l, ctx.p, ctx.n), ir = node_importance(*tree, r, ctx.p, ctx.n);
+    if (!(il + ir > 0)) return 0;
+    float pl = il / (il + ir);
+    prob *= child == l ? pl : 1 - pl;
+  }
+  return prob;
+}
+
+}  // namespace bl

@@ -1,0 +1,83 @@
+// cut_sampling: region lookup, cdf construction, cluster + intensity-descent sampling and its pmf.
+#include "cut_sampling.h"
+
+#include <algorithm>
+
+namespace bl {
+
+void locate_region(cut_context& ctx, const region_state& regions, const shade_point& sp) {
+  ctx.p = sp.p;
+  ctx.n = sp.n;
+  ctx.albedo = sp.albedo;
+  ctx.fine_key = fine_region_key(regions.grid, sp.p);
+  ctx.region = find_region(regions, ctx.fine_key);
+  ctx.count = regions.cut_size[size_t(ctx.region)];
+  ctx.nodes = regions.cut_nodes.data() + regions.cut_offset[size_t(ctx.region)];
+  ctx.tree_count = ctx.count - (regions.has_sun ? 1 : 0);
+}
+
+void finish_cdf(cut_context& ctx, const double* w) {
+  double total = 0;
+  for (int j = 0; j < ctx.count; j++) total += w[j];
+  ctx.cdf[0] = 0;
+  if (!(total > 0) || !std::isfinite(total)) {
+    for (int j = 0; j < ctx.count; j++) ctx.cdf[j + 1] = 0;
+    return;
+  }
+  double acc = 0;
+  int last = -1;
+  for (int j = 0; j < ctx.count; j++) {
+    acc += w[j];
+    ctx.cdf[j + 1] = float(acc / total);
+    if (w[j] > 0) last = j;
+  }
+  for (int j = last; j < ctx.count; j++) ctx.cdf[j + 1] = 1.0f;
+}
+
+light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, float u,
+                        float u_inner) {
+  if (ctx.count == 0 || !(ctx.cdf[ctx.count] > 0)) return {};
+  int j = int(std::upper_bound(ctx.cdf + 1, ctx.cdf + ctx.count + 1, u) - (ctx.cdf + 1));
+  j = std::min(j, ctx.count - 1);
+  float pj = cluster_pmf(ctx, j);
+  if (!(pj > 0)) return {};
+  int node = ctx.nodes[j];
+  if (node == sun_cluster) return {lights.sun, pj, j, 1.0f};
+  float inner = 1;
+  int leaf = sample_by_intensity(tree, node, u_inner, inner);
+  return {tree.light[size_t(leaf)], pj * inner, j, inner};
+}
+
+float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, int light) {
+  if (ctx.count == 0) return 0;
+  if (light == lights.sun) return ctx.nodes[ctx.count - 1] == sun_cluster ? cluster_pmf(ctx, ctx.count - 1) : 0.0f;
+  int leaf = tree.leaf_of_light[size_t(light)];
+  const int* begin = ctx.nodes;
+  const int* end = ctx.nodes + ctx.tree_count;
+  for (int n = leaf; n != invalid_id; n = tree.parent[size_t(n)]) {
+    const int* it = std::lower_bound(begin, end, n);
+    if (it != end && *it == n) {
+      int j = int(it - begin);
+      return cluster_pmf(ctx, j) * intensity_descent_pmf(tree, n, leaf);
+    }
+  }
+  return 0;  // the light's subtree was left out of the cut: it cannot reach this region
+}
+
+int create_requested_regions(region_state& regions, const light_tree_data& tree,
+                             const std::vector<const region_requests*>& rows) {
+  std::vector<uint64_t> keys;
+  for (const region_requests* r : rows) keys.insert(keys.end(), r->keys.begin(), r->keys.end());
+  if (keys.empty()) return 0;
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return add_regions(regions, tree, keys);
+}
+
+void sun_half_angle(const light_data& lights, float& sin_out, float& cos_out) {
+  float omc = lights.sun_one_minus_cos;
+  cos_out = 1 - omc;
+  sin_out = safe_sqrt(omc * (2 - omc));
+}
+
+}  // namespace bl

@@ -1,0 +1,76 @@
+// cut_sampling: light selection over a region's light cut, shared by the bound and bayes samplers.
+// A shading point finds its region (the finest existing one), weighs the clusters of the region's cut, picks a
+// cluster from the normalised weights, then a light inside the cluster by descending the tree proportionally to
+// intensity. Invariants: the context holds the cdf it sampled from, so pmf(light) is exactly the probability
+// sample() returned; a cluster's weight is 0 only when none of its lights can reach the point.
+#pragma once
+
+#include "light_sampler_types.h"
+#include "light_tree.h"
+#include "lights.h"
+#include "region_grid.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace bl {
+
+// Largest cut a region may have (clusters, the sun included).
+constexpr int max_cut_entries = 1025;
+
+// Per shading point: its region and cut and the cdf over the cut's clusters.
+struct cut_context {
+  vec3f p, n;
+  float albedo = 0;
+  uint64_t fine_key = 0;
+  int region = 0;
+  int count = 0;               // clusters in the cut
+  int tree_count = 0;          // of which tree nodes (the sun, if any, is last)
+  const int* nodes = nullptr;  // the cut's node ids
+  float cdf[max_cut_entries + 1];
+};
+
+// Fills the point and region part of a context.
+void locate_region(cut_context& ctx, const region_state& regions, const shade_point& sp);
+
+// Bound-based weight of cluster `node` (a tree node or sun_cluster) at (p, n): its importance.
+inline float cluster_bound(const light_tree_data& tree, const light_data& lights, int node, vec3f p, vec3f n,
+                           float sun_sin, float sun_cos) {
+  if (node == sun_cluster)
+    return luminance(lights.sun_irradiance) * receiver_cos_bound(n, lights.sun_dir, sun_sin, sun_cos);
+  return node_importance(tree, node, p, n);
+}
+// Distance used by the regression for a cluster: to its box centre, clamped below by its radius (sun: 1).
+inline float cluster_distance(const light_tree_data& tree, int node, vec3f p) {
+  if (node == sun_cluster) return 1;
+  return std::max(length(p - tree.center[size_t(node)]), tree.radius[size_t(node)]);
+}
+
+// Normalises non-negative weights (accumulated in double, in cut order) into ctx.cdf.
+void finish_cdf(cut_context& ctx, const double* weights);
+// Probability of cluster j.
+inline float cluster_pmf(const cut_context& ctx, int j) { return ctx.cdf[j + 1] - ctx.cdf[j]; }
+
+// Picks a cluster with u and a light inside it with u_inner.
+light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, float u,
+                        float u_inner);
+// Probability that sample_cut picks `light`.
+float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, int light);
+
+// Fine region keys requested by one image row (shading points whose fine region does not exist yet).
+struct region_requests {
+  std::vector<uint64_t> keys;
+  void clear() { keys.clear(); }
+  void add(const region_state& regions, const cut_context& ctx) {
+    if (regions.key[size_t(ctx.region)] != ctx.fine_key && (keys.empty() || keys.back() != ctx.fine_key))
+      keys.push_back(ctx.fine_key);
+  }
+};
+// Creates the regions requested by all rows (sorted, deduplicated: independent of thread timing).
+int create_requested_regions(region_state& regions, const light_tree_data& tree,
+                             const std::vector<const region_requests*>& rows);
+
+// The sun's half-angle as (sin, cos) for cos bounds.
+void sun_half_angle(const light_data& lights, float& sin_out, float& cos_out);
+
+}  // namespace bl

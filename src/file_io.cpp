@@ -1,0 +1,138 @@
+// file_io: whole-file reads and atomic writes on POSIX file descriptors.
+// Every write, fsync and close is checked (a full disk surfaces as ENOSPC from one of them); EINTR is retried,
+// so a SIGINT handler that does not restart system calls cannot truncate an output.
+#include "file_io.h"
+
+#include "errors.h"
+
+#include <atomic>
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace bl {
+
+// The message of errno value err.
+static std::string reason(int err) { return std::strerror(err); }
+
+// Thrown for every write failure: "cannot write PATH: reason".
+static output_error write_failure(const std::string& path, const std::string& why) {
+  return output_error("cannot write " + path + ": " + why);
+}
+
+// Writes all n bytes to fd, retrying short writes and EINTR; returns 0 or the errno of the failure.
+static int write_all(int fd, const char* data, size_t n) {
+  while (n > 0) {
+    ssize_t k = ::write(fd, data, n);
+    if (k < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    if (k == 0) return EIO;  // a regular file or device that accepts nothing: do not spin
+    data += k;
+    n -= static_cast<size_t>(k);
+  }
+  return 0;
+}
+
+// Closes fd; returns 0 or the errno of the failure (EINTR counts as closed: Linux always releases the fd).
+static int close_checked(int fd) {
+  if (::close(fd) == 0 || errno == EINTR) return 0;
+  return errno;
+}
+
+std::string read_file(const std::string& path) {
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw input_error(path, reason(errno));
+  std::string bytes;
+  struct stat st {};
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) bytes.reserve(size_t(st.st_size));
+  char buf[1 << 16];
+  for (;;) {
+    ssize_t k = ::read(fd, buf, sizeof buf);
+    if (k < 0 && errno == EINTR) continue;
+    if (k < 0) {
+      int err = errno;
+      ::close(fd);
+      throw input_error(path, reason(err));
+    }
+    if (k == 0) break;
+    bytes.append(buf, size_t(k));
+  }
+  ::close(fd);
+  return bytes;
+}
+
+// Writes bytes straight into an existing non-regular file (device, FIFO, socket): renaming over it would
+// replace the node itself. Errors such as ENOSPC from /dev/full are reported like any other.
+static void write_direct(const std::string& path, const std::string& bytes) {
+  int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) throw write_failure(path, reason(errno));
+  int err = write_all(fd, bytes.data(), bytes.size());
+  int cerr = close_checked(fd);
+  if (err == 0) err = cerr;
+  if (err != 0) throw write_failure(path, reason(err));
+}
+
+// Creates a fresh temporary file next to target (O_EXCL: never reuses an existing name); returns its fd and
+// sets tmp_path, or returns -1 with errno set.
+static int create_temporary(const std::string& target, std::string& tmp_path) {
+  // Process-wide counter: unique names for concurrent writes from several threads of this process.
+  static std::atomic<unsigned> counter{0};
+  size_t slash = target.rfind('/');
+  std::string dir = slash == std::string::npos ? std::string() : target.substr(0, slash + 1);
+  std::string name = slash == std::string::npos ? target : target.substr(slash + 1);
+  if (name.size() > 200) name.resize(200);  // keep ".NAME.tmp.<pid>.<n>" under NAME_MAX
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    tmp_path = dir + "." + name + ".tmp." + std::to_string(long(::getpid())) + "." +
+               std::to_string(counter.fetch_add(1));
+    int fd = ::open(tmp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0 || errno != EEXIST) return fd;
+  }
+  errno = EEXIST;
+  return -1;
+}
+
+// The file a symlink at path finally names, so that the rename replaces the target and keeps the link; path
+// itself when it is no symlink or cannot be resolved.
+static std::string rename_target(const std::string& path) {
+  struct stat lst {};
+  if (::lstat(path.c_str(), &lst) != 0 || !S_ISLNK(lst.st_mode)) return path;
+  char* real = ::realpath(path.c_str(), nullptr);
+  if (!real) return path;
+  std::string resolved = real;
+  std::free(real);
+  return resolved;
+}
+
+void write_file_atomic(const std::string& path, const std::string& bytes) {
+  if (path.empty() || path.back() == '/') throw write_failure(path, "not a file name");
+  struct stat st {};
+  const bool exists = ::stat(path.c_str(), &st) == 0;
+  if (exists && !S_ISREG(st.st_mode)) {
+    write_direct(path, bytes);
+    return;
+  }
+  const std::string target = rename_target(path);
+
+  std::string tmp;
+  int fd = create_temporary(target, tmp);
+  if (fd < 0) throw write_failure(path, reason(errno));
+  if (exists) (void)::fchmod(fd, st.st_mode & 07777);  // a replaced file keeps its permissions (best effort)
+  int err = write_all(fd, bytes.data(), bytes.size());
+  // Delayed-allocation and network file systems may report ENOSPC/EIO only here; EINVAL means no fsync support.
+  if (err == 0 && ::fsync(fd) != 0 && errno != EINVAL) err = errno;
+  int cerr = close_checked(fd);
+  if (err == 0) err = cerr;
+  if (err == 0 && ::rename(tmp.c_str(), target.c_str()) != 0) err = errno;
+  if (err != 0) {
+    ::unlink(tmp.c_str());
+    throw write_failure(path, reason(err));
+  }
+}
+
+}  // namespace bl

@@ -1,0 +1,19 @@
+// file_io: whole-file reads and crash-safe writes, with errors that name the path and the reason.
+// Invariants: write_file_atomic never leaves a partial file at the destination, never leaves its temporary
+// behind, and leaves an existing destination untouched when it fails. Device nodes and FIFOs (/dev/null,
+// /dev/full, a pipe) are written directly, never renamed over; their write errors are still reported.
+#pragma once
+
+#include <string>
+
+namespace bl {
+
+// The whole content of a file; throws input_error(path, reason) when it cannot be opened or read.
+std::string read_file(const std::string& path);
+
+// Replaces the file at path with bytes: writes a temporary ".NAME.tmp.<pid>.<n>" in the same directory,
+// checks every write, fsyncs and closes it, then renames it over path. A symlink to a regular file is kept and
+// its target replaced. Throws output_error("cannot write PATH: reason") on any failure.
+void write_file_atomic(const std::string& path, const std::string& bytes);
+
+}  // namespace bl

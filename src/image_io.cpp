@@ -1,0 +1,327 @@
+// image_io: .exr (tinyexr, fp32 RGB), .pfm (own code) and .png (stb_image_write, 8-bit sRGB) files.
+// Invariants: pixels are RGB interleaved, top row first; reads reject anything malformed with an input_error
+// naming the file; every write is encoded in memory first and handed to write_file_atomic, so a failure never
+// leaves a partial file. The PNG encoding uses float maths only (powf), so it is the same on every x86-64 CPU.
+#include "image_io.h"
+
+#include "errors.h"
+#include "file_io.h"
+
+#include <stb_image_write.h>
+#include <tinyexr.h>
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+
+namespace bl {
+
+// Largest accepted width or height, and pixel count, of an input image (guards allocations on bad headers).
+static constexpr int64_t max_image_side = int64_t(1) << 20;
+static constexpr int64_t max_image_pixels = int64_t(1) << 28;
+
+image_format image_format_of(const std::string& path) {
+  size_t slash = path.rfind('/');
+  size_t start = slash == std::string::npos ? 0 : slash + 1;
+  size_t dot = path.rfind('.');
+  if (dot == std::string::npos || dot <= start) return image_format::unknown;  // "x/.exr" has no extension
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == "exr") return image_format::exr;
+  if (ext == "pfm") return image_format::pfm;
+  if (ext == "png") return image_format::png;
+  return image_format::unknown;
+}
+
+// "WxH" for messages.
+static std::string size_text(int64_t w, int64_t h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+// Throws input_error unless w x h is a sensible image size.
+static void check_input_size(const std::string& path, int64_t w, int64_t h) {
+  if (w <= 0 || h <= 0 || w > max_image_side || h > max_image_side || w * h > max_image_pixels)
+    throw input_error(path, "unsupported image size " + size_text(w, h));
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// PFM: "PF" (RGB) or "Pf" (grey), width, height, scale (< 0: little-endian floats), one whitespace byte, then
+// rows of floats from the bottom row up.
+
+// True for the whitespace bytes the netpbm header grammar allows.
+static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
+
+// The next whitespace-separated header token at pos (advanced past it); empty at the end of the data.
+static std::string next_token(const std::string& b, size_t& pos) {
+  while (pos < b.size() && is_space(b[pos])) ++pos;
+  size_t start = pos;
+  while (pos < b.size() && !is_space(b[pos]) && pos - start < 64) ++pos;
+  return b.substr(start, pos - start);
+}
+
+// A PFM width or height token: decimal digits only.
+static int64_t parse_pfm_int(const std::string& path, const std::string& tok, const char* what) {
+  int64_t v = 0;
+  auto [end, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+  if (tok.empty() || ec != std::errc() || end != tok.data() + tok.size() || tok[0] == '-')
+    throw input_error(path, std::string("malformed PFM header: bad ") + what + " '" + tok + "'");
+  return v;
+}
+
+// Decodes the 4 bytes at p as a float of the given byte order (independent of the host's order).
+static float load_float(const unsigned char* p, bool little) {
+  uint32_t u = little ? uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24
+                      : uint32_t(p[3]) | uint32_t(p[2]) << 8 | uint32_t(p[1]) << 16 | uint32_t(p[0]) << 24;
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
+}
+
+// Reads a PF or Pf file of either byte order.
+static image_data read_pfm(const std::string& path) {
+  const std::string b = read_file(path);
+  if (b.size() < 3 || b[0] != 'P' || (b[1] != 'F' && b[1] != 'f') || !is_space(b[2]))
+    throw input_error(path, "not a PFM file (expected 'PF' or 'Pf')");
+  const int channels = b[1] == 'F' ? 3 : 1;
+  size_t pos = 2;
+  int64_t w = parse_pfm_int(path, next_token(b, pos), "width");
+  int64_t h = parse_pfm_int(path, next_token(b, pos), "height");
+  std::string scale_tok = next_token(b, pos);
+  double scale = 0;
+  auto [end, ec] = std::from_chars(scale_tok.data(), scale_tok.data() + scale_tok.size(), scale);
+  if (scale_tok.empty() || ec != std::errc() || end != scale_tok.data() + scale_tok.size() ||
+      !std::isfinite(scale) || scale == 0)
+    throw input_error(path, "malformed PFM header: bad scale '" + scale_tok + "'");
+  if (pos >= b.size() || !is_space(b[pos])) throw input_error(path, "truncated PFM header");
+  check_input_size(path, w, h);
+  const size_t expected = size_t(w) * size_t(h) * size_t(channels) * 4;
+  ++pos;  // the single whitespace byte that ends the header
+  if (b[pos - 1] == '\r' && b.size() - pos == expected + 1 && b[pos] == '\n') ++pos;  // tolerate CRLF
+  const size_t found = b.size() - pos;
+  if (found < expected)
+    throw input_error(path, "truncated PFM data: " + size_text(w, h) + " needs " + std::to_string(expected) +
+                                " bytes, found " + std::to_string(found));
+  if (found > expected)
+    throw input_error(path, std::to_string(found - expected) + " unexpected bytes after the PFM pixel data");
+
+  image_data img;
+  img.width = int(w);
+  img.height = int(h);
+  img.pixels.resize(size_t(w) * size_t(h) * 3);
+  const bool little = scale < 0;
+  const auto* data = reinterpret_cast<const unsigned char*>(b.data()) + pos;
+  for (int64_t fy = 0; fy < h; ++fy) {
+    const int64_t y = h - 1 - fy;  // file rows run bottom to top
+    for (int64_t x = 0; x < w; ++x) {
+      const unsigned char* src = data + size_t((fy * w + x) * channels) * 4;
+      float* dst = &img.pixels[size_t(y * w + x) * 3];
+      for (int c = 0; c < 3; ++c) dst[c] = load_float(src + (channels == 3 ? c : 0) * 4, little);
+    }
+  }
+  return img;
+}
+
+// Little-endian PF bytes (scale -1), rows from the bottom up.
+static std::string encode_pfm(const image_data& img) {
+  std::string out = "PF\n" + std::to_string(img.width) + " " + std::to_string(img.height) + "\n-1.0\n";
+  const size_t header = out.size();
+  out.resize(header + img.pixels.size() * 4);
+  unsigned char* dst = reinterpret_cast<unsigned char*>(&out[header]);
+  const size_t row = size_t(img.width) * 3;
+  for (int fy = 0; fy < img.height; ++fy) {
+    const float* src = &img.pixels[size_t(img.height - 1 - fy) * row];
+    for (size_t i = 0; i < row; ++i, dst += 4) {
+      uint32_t u;
+      std::memcpy(&u, &src[i], 4);
+      for (int k = 0; k < 4; ++k) dst[k] = static_cast<unsigned char>(u >> (8 * k));
+    }
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// EXR through tinyexr's header/image API (LoadEXR leaks on errors and misreads UINT channels).
+
+// A parsed EXR header and its loaded image; frees both on every exit path.
+struct exr_file_data {
+  EXRHeader header;
+  EXRImage image;
+  exr_file_data() {
+    InitEXRHeader(&header);
+    InitEXRImage(&image);
+  }
+  ~exr_file_data() {
+    FreeEXRImage(&image);
+    FreeEXRHeader(&header);
+  }
+  exr_file_data(const exr_file_data&) = delete;
+  exr_file_data& operator=(const exr_file_data&) = delete;
+};
+
+// tinyexr's error text (freed here) or fallback.
+static std::string take_exr_error(const char* err, const std::string& fallback) {
+  std::string msg = err ? std::string(err) : fallback;
+  if (err) FreeEXRErrorMessage(err);
+  while (!msg.empty() && is_space(msg.back())) msg.pop_back();
+  return msg;
+}
+
+// Index of the channel named name, or -1.
+static int find_channel(const EXRHeader& h, const char* name) {
+  for (int c = 0; c < h.num_channels; ++c)
+    if (std::strcmp(h.channels[c].name, name) == 0) return c;
+  return -1;
+}
+
+// Sample i of loaded channel plane p (FLOAT after the HALF->FLOAT request, or UINT).
+static float exr_sample(const unsigned char* p, int pixel_type, size_t i) {
+  if (pixel_type == TINYEXR_PIXELTYPE_UINT) return float(reinterpret_cast<const unsigned int*>(p)[i]);
+  return reinterpret_cast<const float*>(p)[i];
+}
+
+// Reads R, G, B of a single-part scanline EXR (a single-channel file is replicated to grey); alpha and other
+// channels are ignored. Tiled files are rejected: tinyexr's tiled error paths free memory unreliably.
+static image_data read_exr(const std::string& path) {
+  const std::string bytes = read_file(path);
+  const auto* mem = reinterpret_cast<const unsigned char*>(bytes.data());
+  EXRVersion version;
+  if (ParseEXRVersionFromMemory(&version, mem, bytes.size()) != TINYEXR_SUCCESS)
+    throw input_error(path, "not an OpenEXR file");
+  if (version.multipart || version.non_image || version.tiled)
+    throw input_error(path, "tiled, multi-part and deep OpenEXR files are not supported (write scanline RGB)");
+  exr_file_data exr;
+  const char* err = nullptr;
+  if (ParseEXRHeaderFromMemory(&exr.header, &version, mem, bytes.size(), &err) != TINYEXR_SUCCESS)
+    throw input_error(path, "malformed OpenEXR header: " + take_exr_error(err, "unknown error"));
+  const EXRHeader& h = exr.header;
+  int rgb[3] = {find_channel(h, "R"), find_channel(h, "G"), find_channel(h, "B")};
+  if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
+    if (h.num_channels != 1) {
+      std::string names;
+      for (int c = 0; c < h.num_channels && c < 8; ++c) names += std::string(c ? ", " : "") + h.channels[c].name;
+      throw input_error(path, "OpenEXR file has no R, G and B channels (found: " + names + ")");
+    }
+    rgb[0] = rgb[1] = rgb[2] = 0;  // one channel (Y, A, ...): grey
+  }
+  for (int c : rgb)
+    if (h.channels[c].x_sampling != 1 || h.channels[c].y_sampling != 1)
+      throw input_error(path, "subsampled OpenEXR channels are not supported");
+  check_input_size(path, int64_t(h.data_window.max_x) - h.data_window.min_x + 1,
+                   int64_t(h.data_window.max_y) - h.data_window.min_y + 1);
+  for (int c = 0; c < h.num_channels; ++c)
+    if (h.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) exr.header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
+  // tinyexr 1.0.1 sets num_channels only on success, but on a decoding failure frees the planes up to
+  // num_channels (leaking them when it is 0) and leaves the freed pointers in place: preset the count so the
+  // planes are freed, and forget the pointers afterwards so that the destructor does not free them twice.
+  exr.image.num_channels = h.num_channels;
+  if (LoadEXRImageFromMemory(&exr.image, &exr.header, mem, bytes.size(), &err) != TINYEXR_SUCCESS) {
+    InitEXRImage(&exr.image);
+    throw input_error(path, "malformed OpenEXR data: " + take_exr_error(err, "unknown error"));
+  }
+
+  const EXRImage& im = exr.image;
+  if (h.tiled || !im.images) throw input_error(path, "OpenEXR file has no scanline pixel data");
+  check_input_size(path, im.width, im.height);
+  image_data img;
+  img.width = im.width;
+  img.height = im.height;
+  img.pixels.resize(size_t(im.width) * size_t(im.height) * 3);
+  for (size_t i = 0; i < size_t(im.width) * size_t(im.height); ++i)
+    for (int k = 0; k < 3; ++k) img.pixels[i * 3 + k] = exr_sample(im.images[rgb[k]], h.pixel_types[rgb[k]], i);
+  return img;
+}
+
+// fp32 B, G, R planes (the channel order viewers expect), ZIP-compressed (lossless), scanline.
+static std::string encode_exr(const std::string& path, const image_data& img) {
+  const size_t n = size_t(img.width) * size_t(img.height);
+  std::vector<float> planes[3];  // B, G, R
+  for (int c = 0; c < 3; ++c) {
+    planes[c].resize(n);
+    for (size_t i = 0; i < n; ++i) planes[c][i] = img.pixels[i * 3 + size_t(2 - c)];
+  }
+  float* plane_ptrs[3] = {planes[0].data(), planes[1].data(), planes[2].data()};
+  EXRImage image;
+  InitEXRImage(&image);
+  image.images = reinterpret_cast<unsigned char**>(plane_ptrs);
+  image.width = img.width;
+  image.height = img.height;
+  image.num_channels = 3;
+  EXRChannelInfo channels[3] = {};
+  const char* names[3] = {"B", "G", "R"};
+  int pixel_types[3], requested[3];
+  for (int c = 0; c < 3; ++c) {
+    std::strcpy(channels[c].name, names[c]);
+    pixel_types[c] = requested[c] = TINYEXR_PIXELTYPE_FLOAT;
+  }
+  EXRHeader header;  // points at the arrays above: not freed with FreeEXRHeader
+  InitEXRHeader(&header);
+  header.num_channels = 3;
+  header.channels = channels;
+  header.pixel_types = pixel_types;
+  header.requested_pixel_types = requested;
+  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
+  unsigned char* mem = nullptr;
+  const char* err = nullptr;
+  size_t size = SaveEXRImageToMemory(&image, &header, &mem, &err);
+  if (size == 0 || !mem) {
+    std::free(mem);
+    throw output_error("cannot write " + path + ": OpenEXR encoding failed: " + take_exr_error(err, "unknown error"));
+  }
+  std::string out(reinterpret_cast<const char*>(mem), size);
+  std::free(mem);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// PNG: 8-bit sRGB.
+
+// Linear value to an 8-bit sRGB code: NaN -> 0, clamp to [0, 1], sRGB OETF in float, round to nearest.
+static unsigned char linear_to_srgb8(float v) {
+  if (!(v > 0.0f)) return 0;  // also NaN
+  if (v >= 1.0f) return 255;
+  const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;  // float libm
+  return static_cast<unsigned char>(s * 255.0f + 0.5f);
+}
+
+// stb callback appending the encoded bytes to a std::string.
+static void append_bytes(void* context, void* data, int size) {
+  static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(size));
+}
+
+// RGB 8-bit PNG bytes of img.
+static std::string encode_png(const std::string& path, const image_data& img) {
+  std::vector<unsigned char> codes(img.pixels.size());
+  for (size_t i = 0; i < codes.size(); ++i) codes[i] = linear_to_srgb8(img.pixels[i]);
+  std::string out;
+  if (!stbi_write_png_to_func(append_bytes, &out, img.width, img.height, 3, codes.data(), img.width * 3))
+    throw output_error("cannot write " + path + ": PNG encoding failed");
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+
+image_data read_image(const std::string& path) {
+  switch (image_format_of(path)) {
+    case image_format::exr: return read_exr(path);
+    case image_format::pfm: return read_pfm(path);
+    case image_format::png: throw input_error(path, "PNG is 8-bit display output; read images must be .exr or .pfm");
+    case image_format::unknown: break;
+  }
+  throw input_error(path, "unknown image format (expected .exr or .pfm)");
+}
+
+void write_image(const std::string& path, const image_data& img) {
+  if (img.width <= 0 || img.height <= 0 || img.pixels.size() != size_t(img.width) * size_t(img.height) * 3)
+    throw output_error("cannot write " + path + ": invalid " + size_text(img.width, img.height) + " image with " +
+                       std::to_string(img.pixels.size()) + " values");
+  switch (image_format_of(path)) {
+    case image_format::exr: return write_file_atomic(path, encode_exr(path, img));
+    case image_format::pfm: return write_file_atomic(path, encode_pfm(img));
+    case image_format::png: return write_file_atomic(path, encode_png(path, img));
+    case image_format::unknown: break;
+  }
+  throw output_error("cannot write " + path + ": unknown image format (expected .exr, .pfm or .png)");
+}
+
+}  // namespace bl

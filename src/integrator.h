@@ -1,0 +1,161 @@
+// integrator: one path sample — camera ray, emission seen, NEE at every vertex through the light sampler,
+// BSDF continuation with MIS (power heuristic), Russian roulette from the third bounce.
+// Invariants: max_depth D counts bounces: NEE runs at vertices 1..D; at vertex D it is unweighted and the
+// path ends (D = 1 is pure light sampling, the paper's direct-only mode); emission reached by BSDF sampling
+// from vertex k < D is MIS-weighted against NEE at k using the sampler's pmf at k. All randomness comes
+// from draw_vertex(key, vertex) in the dimension table of rng.h. Never returns a non-finite value.
+#pragma once
+
+#include "bvh.h"
+#include "camera.h"
+#include "light_sampler_types.h"
+#include "lights.h"
+#include "material.h"
+#include "rng.h"
+#include "sampling.h"
+#include "scene.h"
+
+#include <cstdint>
+
+namespace bl {
+
+// The read-only inputs of path sampling.
+struct render_inputs {
+  const scene_data* scene = nullptr;
+  const bvh_data* bvh = nullptr;
+  const light_data* lights = nullptr;
+  camera_data camera;
+  int max_depth = 5;
+  uint64_t seed = 0;
+};
+
+// Counters of one worker's share of a pass (summed in a fixed order afterwards).
+struct path_stats {
+  uint64_t camera_rays = 0, shadow_rays = 0, bounce_rays = 0, nee_samples = 0, bad_samples = 0;
+};
+inline void add_stats(path_stats& a, const path_stats& b) {
+  a.camera_rays += b.camera_rays;
+  a.shadow_rays += b.shadow_rays;
+  a.bounce_rays += b.bounce_rays;
+  a.nee_samples += b.nee_samples;
+  a.bad_samples += b.bad_samples;
+}
+
+// A sink that drops NEE events (non-learning samplers).
+struct null_sink {
+  template <class E>
+  void record(const E&) {}
+};
+
+// Whether the light sample is visible from sp: the shadow ray runs between both points, each moved off its
+// own surface (so neither the receiver nor the emitter itself can block it, even at grazing angles).
+inline bool unoccluded(const render_inputs& in, const surface_point& sp, const light_sample& ls) {
+  vec3f o = offset_ray_origin(*in.scene, sp.p, sp.ng, ls.wi);
+  if (ls.dist == inf_f) return !occluded(*in.bvh, o, ls.wi, inf_f);
+  vec3f target = offset_ray_origin(*in.scene, ls.p, ls.n, -ls.wi);
+  vec3f d = target - o;
+  float t = length(d);
+  if (!(t > 0)) return true;
+  return !occluded(*in.bvh, o, d / t, t);
+}
+
+// Radiance of sample `sample` of pixel (x, y).
+template <class Sampler, class Sink>
+vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample, path_stats& st,
+                 Sink& sink) {
+  const scene_data& scene = *in.scene;
+  const light_data& lights = *in.lights;
+  int pixel = y * in.camera.width + x;
+  uint64_t key = sample_key(in.seed, uint64_t(pixel), sample);
+  vertex_randoms cam = draw_vertex(key, 0);
+  vec3f org = in.camera.eye;
+  vec3f dir = camera_ray_dir(in.camera, float(x) + cam.u[dim_pixel_x], float(y) + cam.u[dim_pixel_y]);
+  st.camera_rays++;
+
+  vec3f radiance = {0, 0, 0}, beta = {1, 1, 1};
+  bool prev_mis = false;           // the current ray was BSDF-sampled at a vertex that also ran weighted NEE
+  float prev_bsdf_pdf = 0;
+  // Light-selection contexts of the current and the previous vertex, alternating (no copies of large cdfs).
+  typename Sampler::context ctxs[2];
+  for (int depth = 1;; depth++) {
+    hit_info h = intersect(*in.bvh, org, dir);
+    if (h.tri == invalid_id) {
+      if (in_sun_disk(lights, dir)) {
+        float w = 1;
+        if (prev_mis)
+          w = power_heuristic(prev_bsdf_pdf,
+                              sampler.pmf(ctxs[(depth - 1) & 1], lights.sun) * cone_pdf(lights.sun_one_minus_cos));
+        radiance += beta * lights.sun_radiance * w;
+      }
+      break;
+    }
+    surface_point sp = eval_surface(scene, h.tri, h.b1, h.b2, dir);
+    vec3f wo = -dir;
+    int hit_light = lights.light_of_tri[h.tri];
+    if (hit_light != invalid_id) {
+      vec3f le = emitted_radiance(lights, hit_light, sp.front);
+      if (!is_black(le)) {
+        float w = 1;
+        if (prev_mis) {
+          float cos_l = std::fabs(dot(scene.tri_ng[h.tri], dir));
+          float light_pdf = sampler.pmf(ctxs[(depth - 1) & 1], hit_light) *
+                            triangle_light_pdf(scene, lights, hit_light, h.t, cos_l);
+          w = power_heuristic(prev_bsdf_pdf, light_pdf);
+        }
+        radiance += beta * le * w;
+      }
+    }
+    bsdf_data bsdf = make_bsdf(scene, sp);
+    if (is_black_bsdf(bsdf)) break;
+    vertex_randoms r = draw_vertex(key, uint32_t(depth));
+    bool last = depth >= in.max_depth;
+    typename Sampler::context& ctx = ctxs[depth & 1];
+    sampler.prepare(ctx, shade_point{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth});
+
+    // Next-event estimation.
+    light_choice choice = sampler.sample(ctx, r.u[dim_light_select], r.u[dim_light_inner]);
+    if (choice.light != invalid_id && choice.prob > 0) {
+      st.nee_samples++;
+      float value = 0;
+      light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, r.u[dim_light_u], r.u[dim_light_v]);
+      if (ls.pdf > 0) {
+        vec3f fc = eval_bsdf_cos(bsdf, wo, ls.wi);
+        if (!is_black(fc)) {
+          st.shadow_rays++;
+          if (unoccluded(in, sp, ls)) {
+            vec3f unweighted = fc * ls.le / ls.pdf;
+            float w = last ? 1.0f : power_heuristic(choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
+            radiance += beta * unweighted * (w / choice.prob);
+            value = luminance(unweighted) / choice.prob_in_cluster;
+          }
+        }
+      }
+      if constexpr (Sampler::learns) sink.record(nee_event<typename Sampler::context>{&ctx, choice, value});
+    }
+    if (last) break;
+
+    // BSDF continuation.
+    bsdf_sample bs = sample_bsdf(bsdf, wo, r.u[dim_bsdf_lobe], r.u[dim_bsdf_u], r.u[dim_bsdf_v]);
+    if (!(bs.pdf > 0)) break;
+    vec3f fc = eval_bsdf_cos(bsdf, wo, bs.wi);
+    if (is_black(fc)) break;
+    beta = beta * fc / bs.pdf;
+    if (depth >= 3) {
+      float q = std::min(1.0f, max_component(beta));
+      if (!(r.u[dim_roulette] < q)) break;
+      beta = beta / q;
+    }
+    prev_mis = true;
+    prev_bsdf_pdf = bs.pdf;
+    org = offset_ray_origin(scene, sp.p, sp.ng, bs.wi);
+    dir = bs.wi;
+    st.bounce_rays++;
+  }
+  if (!is_finite(radiance)) {
+    st.bad_samples++;
+    return {0, 0, 0};
+  }
+  return radiance;
+}
+
+}  // namespace bl

@@ -1,0 +1,119 @@
+// light_sampler: names of the closed set, construction of each sampler, region discovery.
+#include "light_sampler.h"
+
+#include "errors.h"
+#include "integrator.h"
+
+#include <algorithm>
+
+namespace bl {
+
+namespace {
+
+constexpr sampler_kind all_kinds[] = {sampler_kind::uniform, sampler_kind::power,    sampler_kind::bvh,
+                                      sampler_kind::bound,   sampler_kind::donikian, sampler_kind::bayes};
+
+// Fine region keys of the first hits of rays through every pixel centre (sorted, unique).
+std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_grid_data& grid) {
+  std::vector<uint64_t> keys;
+  int w = in.camera.width, h = in.camera.height;
+  keys.reserve(size_t(w) * size_t(h));
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      vec3f dir = camera_ray_dir(in.camera, float(x) + 0.5f, float(y) + 0.5f);
+      hit_info hit = intersect(*in.bvh, in.camera.eye, dir);
+      if (hit.tri == invalid_id) continue;
+      surface_point sp = eval_surface(*in.scene, hit.tri, hit.b1, hit.b2, dir);
+      keys.push_back(fine_region_key(grid, sp.p));
+    }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return keys;
+}
+
+// Regions of a cut-based sampler: the grid, the root, and the regions of directly visible surfaces.
+region_state make_regions(const sampler_params& params, const render_inputs& in, const light_tree_data& tree) {
+  region_params rp = params.regions;
+  rp.max_cut = std::min(std::max(rp.max_cut, 1), max_cut_entries - 1);
+  region_state s = make_region_state(in.scene->bounds, tree, in.lights->sun != invalid_id, rp);
+  add_regions(s, tree, camera_region_keys(in, s.grid));
+  return s;
+}
+
+}  // namespace
+
+const char* sampler_name(sampler_kind kind) {
+  switch (kind) {
+    case sampler_kind::uniform: return "uniform";
+    case sampler_kind::power: return "power";
+    case sampler_kind::bvh: return "bvh";
+    case sampler_kind::bound: return "bound";
+    case sampler_kind::donikian: return "donikian";
+    case sampler_kind::bayes: return "bayes";
+  }
+  return "?";
+}
+
+bool parse_sampler_kind(const std::string& name, sampler_kind& kind) {
+  for (sampler_kind k : all_kinds)
+    if (name == sampler_name(k)) {
+      kind = k;
+      return true;
+    }
+  return false;
+}
+
+std::string sampler_names() {
+  std::string s;
+  for (sampler_kind k : all_kinds) s += std::string(s.empty() ? "" : " | ") + sampler_name(k);
+  return s;
+}
+
+bool sampler_available(sampler_kind kind) { return kind != sampler_kind::donikian; }
+
+bool needs_light_tree(sampler_kind kind) {
+  return kind == sampler_kind::bvh || kind == sampler_kind::bound || kind == sampler_kind::bayes ||
+         kind == sampler_kind::donikian;
+}
+
+light_sampler make_light_sampler(const sampler_params& params, const render_inputs& in, const light_tree_data& tree) {
+  const light_data& lights = *in.lights;
+  float sun_sin = 0, sun_cos = 1;
+  if (lights.sun != invalid_id) sun_half_angle(lights, sun_sin, sun_cos);
+  switch (params.kind) {
+    case sampler_kind::uniform: return uniform_sampler{lights.count};
+    case sampler_kind::power: return power_sampler{make_discrete(lights.power.data(), lights.count)};
+    case sampler_kind::bvh: return bvh_sampler{&tree, &lights, sun_sin, sun_cos};
+    case sampler_kind::bound: {
+      bound_sampler s;
+      s.tree = &tree;
+      s.lights = &lights;
+      s.sun_sin = sun_sin;
+      s.sun_cos = sun_cos;
+      s.regions = make_regions(params, in, tree);
+      return s;
+    }
+    case sampler_kind::bayes: {
+      bayes_sampler s;
+      s.tree = &tree;
+      s.lights = &lights;
+      s.sun_sin = sun_sin;
+      s.sun_cos = sun_cos;
+      s.params = params.bayes;
+      s.regions = make_regions(params, in, tree);
+      resize_stats(s.stats, s.regions.pairs);
+      return s;
+    }
+    default: break;
+  }
+  throw usage_error(std::string("sampler \"") + sampler_name(params.kind) + "\" is not available in this build");
+}
+
+size_t sampler_memory_bytes(const light_sampler& s) {
+  if (auto* b = std::get_if<bound_sampler>(&s)) return region_memory_bytes(b->regions);
+  if (auto* b = std::get_if<bayes_sampler>(&s))
+    return region_memory_bytes(b->regions) + b->stats.n0.size() * 4 * sizeof(double);
+  return 0;
+}
+
+}  // namespace bl

@@ -1,0 +1,41 @@
+// light_sampler: the closed set of light-selection strategies for NEE (SPEC.md section 7) and their
+// construction by name. The contract each member satisfies is described in light_sampler_types.h.
+#pragma once
+
+#include "bayes_sampler.h"
+#include "bound_sampler.h"
+#include "bvh_sampler.h"
+#include "light_sampler_types.h"
+#include "light_tree.h"
+#include "lights.h"
+#include "region_grid.h"
+#include "scene.h"
+#include "simple_samplers.h"
+
+#include <variant>
+
+namespace bl {
+
+struct render_inputs;
+
+// The closed set.
+using light_sampler = std::variant<uniform_sampler, power_sampler, bvh_sampler, bound_sampler, bayes_sampler>;
+
+// Options of light selection (ablation switches of the adaptive samplers included).
+struct sampler_params {
+  sampler_kind kind = sampler_kind::bayes;
+  region_params regions;
+  bayes_params bayes;
+};
+
+// Whether a sampler kind uses the light tree.
+bool needs_light_tree(sampler_kind kind);
+
+// Builds the sampler of `params.kind`; `tree` must outlive it. Region-based samplers discover the regions of the
+// camera's first hits up front (one ray per pixel centre). Throws usage_error for a kind this build lacks.
+light_sampler make_light_sampler(const sampler_params& params, const render_inputs& in, const light_tree_data& tree);
+
+// Memory held by a sampler's learned or per-region state (regions, cuts, statistics), in bytes.
+size_t sampler_memory_bytes(const light_sampler& s);
+
+}  // namespace bl

@@ -1,0 +1,57 @@
+// light_sampler_types: the vocabulary every light sampler shares — sampler kinds and their names, what a
+// sampler sees of a shading point, and what it returns.
+// The contract of a sampler type S (dispatched once per pass by std::visit, never per sample):
+//   S::context                               per-vertex scratch, filled by prepare (no allocation)
+//   void prepare(context&, const shade_point&) const
+//   light_choice sample(const context&, float u_select, float u_inner) const
+//   float pmf(const context&, int light) const      exactly the probability sample() gives `light`
+//   void end_pass()                                  between passes (non-learning samplers)
+//   static constexpr bool learns; learners also have S::row_state, record(row_state&, const nee_event&)
+//   and learn(std::vector<row_state>&) called between passes with the rows in image order.
+// Invariant (unbiasedness): every light that can contribute at a point has pmf > 0 there.
+#pragma once
+
+#include "math.h"
+
+#include <string>
+
+namespace bl {
+
+// The sampler names of the command line, in the order of SPEC.md section 7.
+enum class sampler_kind { uniform, power, bvh, bound, donikian, bayes };
+// Name of a sampler kind.
+const char* sampler_name(sampler_kind kind);
+// Parses a sampler name; false when unknown.
+bool parse_sampler_kind(const std::string& name, sampler_kind& kind);
+// "uniform | power | ..." for messages.
+std::string sampler_names();
+// Whether a sampler kind is implemented in this build.
+bool sampler_available(sampler_kind kind);
+
+// What light selection sees of a shading point.
+struct shade_point {
+  vec3f p;           // position
+  vec3f n;           // unit geometric normal on the side the path arrives from
+  float albedo = 0;  // luminance of the BSDF's albedos (kd + ks), scale of the expected contribution
+  int pixel = 0;     // image pixel of the path
+  int depth = 1;     // 1 = first hit
+};
+
+// A chosen light with its selection probability; cluster is the sampler's own bookkeeping (or -1).
+struct light_choice {
+  int light = invalid_id;
+  float prob = 0;
+  int cluster = invalid_id;
+  float prob_in_cluster = 1;  // P(light | cluster); prob = P(cluster) * prob_in_cluster
+};
+
+// One NEE event as a learning sampler sees it: its own context, the choice, and the sample's luminance
+// Y = f cos Le G V / (P(light | cluster) pdf) (zero when occluded or facing away).
+template <class Context>
+struct nee_event {
+  const Context* context;
+  light_choice choice;
+  float value;
+};
+
+}  // namespace bl

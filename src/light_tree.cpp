@@ -1,0 +1,278 @@
+// light_tree: binned SAOH build (12 bins per axis; cost = intensity * M_omega(cone) * surface area, as in
+// Conty Estevez & Kulla 2018), normal-cone unions, region bounds and intensity descent.
+#include "light_tree.h"
+
+#include <algorithm>
+#include <numeric>
+
+namespace bl {
+
+namespace {
+
+// A normal cone (axis, half-angle theta) during the build; empty cones hold no direction yet.
+struct cone_bound {
+  vec3f axis = {0, 0, 1};
+  float theta = 0;
+  bool empty = true;
+};
+
+// The smallest cone (Conty-Kulla's union) containing both cones.
+cone_bound cone_union(cone_bound a, cone_bound b) {
+  if (a.empty) return b;
+  if (b.empty) return a;
+  if (b.theta > a.theta) std::swap(a, b);
+  float theta_d = safe_acos(dot(a.axis, b.axis));
+  if (std::min(theta_d + b.theta, pi_f) <= a.theta) return a;
+  float theta = 0.5f * (a.theta + theta_d + b.theta);
+  if (theta >= pi_f) return {a.axis, pi_f, false};
+  float theta_r = theta - a.theta;
+  vec3f wr = cross(a.axis, b.axis);
+  if (!(length_sq(wr) > 0)) return {a.axis, pi_f, false};
+  wr = normalize(wr);
+  // Rotate a.axis by theta_r toward b.axis (a.axis is perpendicular to wr).
+  vec3f axis = normalize(a.axis * std::cos(theta_r) + cross(wr, a.axis) * std::sin(theta_r));
+  return {axis, theta, false};
+}
+
+// Bounds of a set of emitters during the build.
+struct build_bounds {
+  bbox3f box;
+  cone_bound cone;
+  float intensity = 0;
+};
+build_bounds merge_bounds(const build_bounds& a, const build_bounds& b) {
+  return {merge(a.box, b.box), cone_union(a.cone, b.cone), a.intensity + b.intensity};
+}
+
+float surface_area(const bbox3f& b) {
+  if (is_empty(b)) return 0;
+  vec3f e = extent(b);
+  return 2 * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+
+// Orientation measure M_omega of a cone (theta_e = pi / 2 for diffuse emitters).
+float orientation_measure(const cone_bound& c) {
+  float theta_o = c.theta, theta_e = 0.5f * pi_f;
+  float theta_w = std::min(theta_o + theta_e, pi_f);
+  float so = std::sin(theta_o), co = std::cos(theta_o);
+  return 2 * pi_f * (1 - co) +
+         0.5f * pi_f * (2 * theta_w * so - std::cos(theta_o - 2 * theta_w) - 2 * theta_o * so + co);
+}
+
+float split_cost(const build_bounds& b) {
+  return b.intensity * orientation_measure(b.cone) * std::max(surface_area(b.box), 1e-30f);
+}
+
+// Per-light inputs of the build.
+struct build_item {
+  build_bounds bounds;
+  vec3f centroid;
+  int light;
+};
+
+struct builder {
+  light_tree_data& t;
+  std::vector<build_item>& items;
+  int next = 0;
+
+  // Builds the subtree over items [b, e) and returns its node id (nodes are numbered in depth-first order).
+  int build(int b, int e, int parent, int depth) {
+    int node = next++;
+    t.parent[size_t(node)] = parent;
+    t.depth = std::max(t.depth, depth);
+    build_bounds bounds;
+    bbox3f cbox;
+    for (int i = b; i < e; i++) {
+      bounds = merge_bounds(bounds, items[size_t(i)].bounds);
+      cbox = merge(cbox, items[size_t(i)].centroid);
+    }
+    store(node, bounds);
+    if (e - b == 1) {
+      int l = items[size_t(b)].light;
+      t.light[size_t(node)] = l;
+      t.leaf_of_light[size_t(l)] = node;
+      return node;
+    }
+    int mid = split(b, e, bounds, cbox, depth);
+    t.left[size_t(node)] = build(b, mid, node, depth + 1);
+    t.right[size_t(node)] = build(mid, e, node, depth + 1);
+    return node;
+  }
+
+  void store(int node, const build_bounds& bb) {
+    size_t i = size_t(node);
+    t.lo[i] = bb.box.lo;
+    t.hi[i] = bb.box.hi;
+    t.center[i] = center(bb.box);
+    t.radius[i] = 0.5f * diagonal(bb.box);
+    t.axis[i] = bb.cone.axis;
+    t.cos_o[i] = std::cos(bb.cone.theta);
+    t.sin_o[i] = std::sin(bb.cone.theta);
+    if (bb.cone.theta >= pi_f) t.cos_o[i] = -1, t.sin_o[i] = 0;
+    t.intensity[i] = bb.intensity;
+  }
+
+  // Chooses the split of items [b, e) and partitions them; returns the first index of the right half.
+  // Below depth max_sah_depth only median splits are made, so the depth stays under max_tree_depth.
+  int split(int b, int e, const build_bounds& bounds, const bbox3f& cbox, int depth) {
+    constexpr int bins = 12;
+    vec3f ext = extent(bounds.box);
+    float max_ext = max_component(ext);
+    float best_cost = inf_f;
+    int best_axis = -1, best_bin = -1;
+    for (int axis = 0; axis < 3 && depth < max_sah_depth; axis++) {
+      float lo = cbox.lo[axis], hi = cbox.hi[axis];
+      if (!(hi > lo)) continue;
+      build_bounds bin[bins];
+      for (int i = b; i < e; i++) {
+        int k = std::min(bins - 1, int(bins * ((items[size_t(i)].centroid[axis] - lo) / (hi - lo))));
+        bin[k] = merge_bounds(bin[k], items[size_t(i)].bounds);
+      }
+      build_bounds below[bins];
+      build_bounds acc;
+      for (int k = 0; k < bins; k++) below[k] = acc = merge_bounds(acc, bin[k]);
+      acc = {};
+      // Kr penalises thin slabs along the split axis (pbrt-v4's regularisation).
+      float kr = ext[axis] > 0 ? max_ext / ext[axis] : 1.0f;
+      for (int k = bins - 1; k >= 1; k--) {
+        acc = merge_bounds(acc, bin[k]);
+        if (below[k - 1].intensity == 0 && is_empty(below[k - 1].box)) continue;
+        if (is_empty(acc.box)) continue;
+        float cost = kr * (split_cost(below[k - 1]) + split_cost(acc));
+        if (cost < best_cost) best_cost = cost, best_axis = axis, best_bin = k;
+      }
+    }
+    int mid = b;
+    if (best_axis >= 0) {
+      float lo = cbox.lo[best_axis], hi = cbox.hi[best_axis];
+      auto first = items.begin() + b, last = items.begin() + e;
+      mid = int(std::partition(first, last, [&](const build_item& it) {
+                  int k = std::min(bins - 1, int(bins * ((it.centroid[best_axis] - lo) / (hi - lo))));
+                  return k < best_bin;
+                }) - items.begin());
+    }
+    if (mid == b || mid == e) {
+      // No useful split (coincident centroids): halve by (centroid on the widest axis, light index).
+      int axis = 0;
+      vec3f ce = extent(cbox);
+      if (ce.y > ce[axis]) axis = 1;
+      if (ce.z > ce[axis]) axis = 2;
+      mid = (b + e) / 2;
+      std::nth_element(items.begin() + b, items.begin() + mid, items.begin() + e,
+                       [axis](const build_item& x, const build_item& y) {
+                         if (x.centroid[axis] != y.centroid[axis]) return x.centroid[axis] < y.centroid[axis];
+                         return x.light < y.light;
+                       });
+    }
+    return mid;
+  }
+};
+
+// Squared distance between two boxes (0 when they overlap).
+float box_distance_sq(vec3f alo, vec3f ahi, vec3f blo, vec3f bhi) {
+  float d2 = 0;
+  for (int k = 0; k < 3; k++) {
+    float gap = std::max(0.0f, std::max(alo[k] - bhi[k], blo[k] - ahi[k]));
+    d2 += gap * gap;
+  }
+  return d2;
+}
+
+}  // namespace
+
+light_tree_data build_light_tree(const light_data& lights, const scene_data& scene) {
+  light_tree_data t;
+  t.two_sided = lights.two_sided;
+  int n = lights.tri_count;
+  t.leaf_of_light.assign(size_t(n), invalid_id);
+  if (n == 0) return t;
+  std::vector<build_item> items(static_cast<size_t>(n));
+  for (int l = 0; l < n; l++) {
+    int tri = lights.tri[size_t(l)];
+    vec3f p0 = scene.tri_p0[size_t(tri)];
+    vec3f p1 = p0 + scene.tri_e1[size_t(tri)], p2 = p0 + scene.tri_e2[size_t(tri)];
+    build_item& it = items[size_t(l)];
+    it.bounds.box = merge(merge(merge(bbox3f{}, p0), p1), p2);
+    it.bounds.cone = {scene.tri_ng[size_t(tri)], lights.two_sided ? pi_f : 0.0f, false};
+    it.bounds.intensity = luminance(lights.radiance[size_t(l)]) * scene.tri_area[size_t(tri)];
+    it.centroid = center(it.bounds.box);
+    it.light = l;
+  }
+  size_t nodes = size_t(2 * n - 1);
+  t.lo.resize(nodes);
+  t.hi.resize(nodes);
+  t.center.resize(nodes);
+  t.radius.resize(nodes);
+  t.axis.resize(nodes);
+  t.cos_o.resize(nodes);
+  t.sin_o.resize(nodes);
+  t.intensity.resize(nodes);
+  t.left.assign(nodes, invalid_id);
+  t.right.assign(nodes, invalid_id);
+  t.parent.assign(nodes, invalid_id);
+  t.light.assign(nodes, invalid_id);
+  builder bld{t, items};
+  bld.build(0, n, invalid_id, 0);
+  return t;
+}
+
+float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
+  size_t i = size_t(node);
+  vec3f cb = (lo + hi) * 0.5f;
+  float rb = 0.5f * length(hi - lo);
+  vec3f to_b = cb - t.center[i];
+  float d = length(to_b);
+  float r = rb + t.radius[i];
+  float sin_b = 0, cos_b = -1;
+  if (d > r) {
+    sin_b = r / d;
+    cos_b = safe_sqrt(1 - sin_b * sin_b);
+  }
+  vec3f w = d > 0 ? to_b / d : vec3f{0, 0, 1};
+  float ce = node_emitter_cos_bound(t, node, w, sin_b, cos_b);
+  if (ce == 0) return 0;
+  float d2 = box_distance_sq(lo, hi, t.lo[i], t.hi[i]);
+  return t.intensity[i] * ce / std::max(d2, rb * rb);
+}
+
+// Probability of taking the left child of an interior node when descending by intensity.
+static float left_probability(const light_tree_data& t, int node) {
+  float il = t.intensity[size_t(t.left[size_t(node)])], ir = t.intensity[size_t(t.right[size_t(node)])];
+  return il + ir > 0 ? il / (il + ir) : 0.5f;
+}
+
+float intensity_descent_pmf(const light_tree_data& t, int node, int leaf) {
+  // Collect the path bottom-up, then multiply top-down: the same float products as sample_by_intensity.
+  int path[max_tree_depth + 1];
+  int len = 0;
+  for (int n = leaf; n != node; n = t.parent[size_t(n)]) {
+    if (n == invalid_id || len > max_tree_depth) return 0;  // leaf is not below node
+    path[len++] = n;
+  }
+  float prob = 1;
+  for (int k = len - 1; k >= 0; k--) {
+    int child = path[k], p = t.parent[size_t(child)];
+    float pl = left_probability(t, p);
+    prob *= t.left[size_t(p)] == child ? pl : 1 - pl;
+  }
+  return prob;
+}
+
+int sample_by_intensity(const light_tree_data& t, int node, float u, float& prob) {
+  prob = 1;
+  while (!is_leaf(t, node)) {
+    float pl = left_probability(t, node);
+    if (u < pl) {
+      u = std::min(u / pl, 0x1.fffffep-1f);
+      prob *= pl;
+      node = t.left[size_t(node)];
+    } else {
+      u = std::min((u - pl) / (1 - pl), 0x1.fffffep-1f);
+      prob *= 1 - pl;
+      node = t.right[size_t(node)];
+    }
+  }
+  return node;
+}
+
+}  // namespace bl

@@ -1,0 +1,68 @@
+// lights: emitter collection, power, and point sampling (area-uniform on triangles, uniform in the sun's cone).
+#include "lights.h"
+
+#include "sampling.h"
+
+namespace bl {
+
+light_data build_lights(const scene_data& scene) {
+  light_data l;
+  const mesh_data& m = scene.mesh;
+  int n = triangle_count(m);
+  l.two_sided = scene.two_sided_emitters;
+  l.light_of_tri.assign(n, invalid_id);
+  for (int t = 0; t < n; t++) {
+    if (!scene.material_emissive[m.tri_materials[t]]) continue;
+    l.light_of_tri[t] = int(l.tri.size());
+    l.tri.push_back(t);
+    vec3f le = m.materials[m.tri_materials[t]].ke;
+    l.radiance.push_back(le);
+    l.power.push_back(luminance(le) * scene.tri_area[t] * pi_f * (l.two_sided ? 2.0f : 1.0f));
+  }
+  l.tri_count = int(l.tri.size());
+  l.count = l.tri_count;
+  if (scene.sun.enabled && max_component(scene.sun.irradiance) > 0) {
+    l.sun = l.count++;
+    l.sun_dir = normalize(scene.sun.direction);
+    l.sun_frame = make_frame(l.sun_dir);
+    float half = 0.5f * scene.sun.angular_diameter_deg * pi_f / 180.0f;
+    float s = std::sin(0.5f * half);
+    l.sun_one_minus_cos = 2 * s * s;  // 1 - cos(half) without cancellation
+    float sin2 = l.sun_one_minus_cos * (2 - l.sun_one_minus_cos);
+    l.sun_irradiance = scene.sun.irradiance;
+    l.sun_radiance = scene.sun.irradiance / (pi_f * sin2);
+    // Power of a distant light: its irradiance over the disk that bounds the scene (as pbrt does).
+    float r = 0.5f * diagonal(scene.bounds);
+    l.power.push_back(luminance(scene.sun.irradiance) * pi_f * r * r);
+  }
+  return l;
+}
+
+light_sample sample_light_point(const light_data& l, const scene_data& scene, int light, vec3f x, float u,
+                                float v) {
+  light_sample s;
+  if (light == l.sun) {
+    s.wi = normalize(to_world(l.sun_frame, sample_cone(u, v, l.sun_one_minus_cos)));
+    s.dist = inf_f;
+    s.le = l.sun_radiance;
+    s.pdf = cone_pdf(l.sun_one_minus_cos);
+    return s;
+  }
+  int t = l.tri[light];
+  vec2f b = sample_triangle(u, v);
+  s.p = scene.tri_p0[t] + scene.tri_e1[t] * b.x + scene.tri_e2[t] * b.y;
+  s.n = scene.tri_ng[t];
+  vec3f d = s.p - x;
+  float dist2 = length_sq(d);
+  if (!(dist2 > 0)) return s;
+  s.dist = std::sqrt(dist2);
+  s.wi = d / s.dist;
+  float cos_l = -dot(s.n, s.wi);
+  if (cos_l < 0 && l.two_sided) cos_l = -cos_l;
+  if (!(cos_l > 0)) return s;
+  s.le = l.radiance[light];
+  s.pdf = triangle_light_pdf(scene, l, light, s.dist, cos_l);
+  return s;
+}
+
+}  // namespace bl

@@ -1,0 +1,62 @@
+// lights: the emitters of a scene — every triangle with non-zero Ke, and the sun — as flat columns.
+// Invariants: light ids are dense: 0..tri_count-1 are emissive triangles in scene triangle order, the sun
+// (if any) is id tri_count. Point sampling and its pdf sit side by side; pdfs are solid angle at the
+// shading point. A sample that cannot contribute (behind a one-sided emitter, zero distance) has pdf 0.
+#pragma once
+
+#include "math.h"
+#include "scene.h"
+
+#include <vector>
+
+namespace bl {
+
+// All emitters of a scene.
+struct light_data {
+  std::vector<int> tri;         // per emissive triangle: scene triangle
+  std::vector<vec3f> radiance;  // per emissive triangle: Le
+  std::vector<float> power;     // per light (sun included): luminance power, for the power sampler
+  std::vector<int> light_of_tri;  // per scene triangle: its light id or invalid_id
+  int tri_count = 0;            // emissive triangles
+  int count = 0;                // tri_count + (sun ? 1 : 0)
+  bool two_sided = false;
+  // The sun: a distant disk of uniform radiance seen under half-angle theta_max.
+  int sun = invalid_id;         // its light id, or invalid_id
+  vec3f sun_dir;                // unit, from the scene toward the sun
+  vec3f sun_radiance;           // irradiance / (pi sin^2 theta_max)
+  vec3f sun_irradiance;
+  float sun_one_minus_cos = 0;  // 1 - cos(theta_max)
+  frame3f sun_frame;
+};
+
+// Collects the emitters of a scene.
+light_data build_lights(const scene_data& scene);
+
+// A point (or, for the sun, a direction) sampled on one light as seen from a shading point.
+struct light_sample {
+  vec3f wi;                 // unit direction from the shading point toward the light
+  float dist = inf_f;       // distance to the sampled point (inf for the sun)
+  vec3f le;                 // radiance arriving along -wi
+  float pdf = 0;            // solid-angle pdf given the light; 0 = no possible contribution
+  vec3f p, n;               // the point and the emitter's geometric normal (triangles only)
+};
+
+// Samples a point of light `light` seen from x with uniforms (u, v).
+light_sample sample_light_point(const light_data& lights, const scene_data& scene, int light, vec3f x, float u,
+                                float v);
+// Solid-angle pdf of sampling a triangle light's point at distance dist whose emitter cosine is cos_l.
+inline float triangle_light_pdf(const scene_data& scene, const light_data& lights, int light, float dist,
+                                float cos_l) {
+  float a = scene.tri_area[lights.tri[light]];
+  return cos_l > 0 && a > 0 ? dist * dist / (cos_l * a) : 0;
+}
+// Radiance an emissive triangle sends toward a ray that hit its front (front=true) or back side.
+inline vec3f emitted_radiance(const light_data& lights, int light, bool front) {
+  return front || lights.two_sided ? lights.radiance[light] : vec3f{0, 0, 0};
+}
+// Whether a direction lies inside the sun's disk.
+inline bool in_sun_disk(const light_data& lights, vec3f dir) {
+  return lights.sun != invalid_id && 1 - dot(dir, lights.sun_dir) <= lights.sun_one_minus_cos;
+}
+
+}  // namespace bl

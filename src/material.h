@@ -1,0 +1,40 @@
+// material: the BSDF of a surface point — Lambertian diffuse (Kd, map_Kd) plus a normalized Phong lobe
+// (Ks, Ns), reflecting on the side the light arrives from; evaluation, sampling and pdf side by side.
+// Invariants: directions are world-space unit vectors pointing away from the surface; wo is on the side
+// of sp.ng; no transmission (wi below the geometric normal gives 0); kd + ks <= 1 per channel (scaled
+// down otherwise) so no material creates energy.
+#pragma once
+
+#include "math.h"
+#include "scene.h"
+
+namespace bl {
+
+// The BSDF at one surface point, resolved from material and textures.
+struct bsdf_data {
+  vec3f kd, ks;       // albedos after energy scaling
+  float ns = 1;       // Phong exponent
+  float spec_prob = 0;  // probability of sampling the Phong lobe
+  frame3f frame;      // shading frame about sp.ns
+  vec3f ng;           // geometric normal on the wo side
+};
+
+// The BSDF at sp.
+bsdf_data make_bsdf(const scene_data& scene, const surface_point& sp);
+// Whether the BSDF reflects anything (a black surface ends the path).
+inline bool is_black_bsdf(const bsdf_data& b) { return is_black(b.kd) && is_black(b.ks); }
+
+// f(wo, wi) * |cos(wi, ns)| (zero below the geometric surface).
+vec3f eval_bsdf_cos(const bsdf_data& b, vec3f wo, vec3f wi);
+// Solid-angle pdf of sample_bsdf producing wi.
+float bsdf_pdf(const bsdf_data& b, vec3f wo, vec3f wi);
+
+// A sampled direction with its pdf; pdf == 0 means the sample failed (below the surface).
+struct bsdf_sample {
+  vec3f wi;
+  float pdf = 0;
+};
+// Samples wi from the lobe mixture with uniforms (lobe, u, v).
+bsdf_sample sample_bsdf(const bsdf_data& b, vec3f wo, float lobe, float u, float v);
+
+}  // namespace bl

@@ -1,0 +1,320 @@
+// obj_io: turns a validated OBJ (obj_validate) into mesh_data. tinyobjloader parses the clean text (numbers,
+// index triples, negative indices, usemtl ids); we triangulate, drop degenerate triangles, compact the vertex
+// arrays and load each distinct texture once.
+// Invariants: triangles keep the polygon's winding and come in file order; arrays hold only referenced
+// elements, in file order; nothing iterates a hash or pointer order; geometry tests are float maths.
+#include "obj_io.h"
+
+#include "errors.h"
+#include "obj_validate.h"
+
+#include <tiny_obj_loader.h>
+
+#include <climits>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <new>
+#include <stdexcept>
+
+namespace bl {
+
+namespace fs = std::filesystem;
+
+// Inner-loop steps ear clipping may spend on one file before falling back to fans (bounds hostile input).
+constexpr long long ear_clip_budget = 200'000'000;
+
+// Triangulation work left for this file, and how many polygons ran out of it.
+struct triangulate_state {
+  long long budget = ear_clip_budget;
+  int fan_fallbacks = 0;
+};
+
+// Twice the signed area of 2D triangle (a, b, c): positive when it turns counter-clockwise.
+static double cross2(const double* x, const double* y, int a, int b, int c) {
+  return (x[b] - x[a]) * (y[c] - y[a]) - (y[b] - y[a]) * (x[c] - x[a]);
+}
+
+// True when point q lies inside or on triangle (a, b, c) (counter-clockwise) in 2D.
+static bool in_triangle(const double* x, const double* y, int a, int b, int c, int q) {
+  return cross2(x, y, a, b, q) >= 0 && cross2(x, y, b, c, q) >= 0 && cross2(x, y, c, a, q) >= 0;
+}
+
+// Ear clipping of a simple counter-clockwise 2D polygon into n-2 triangles of local corner indices.
+// Only reflex corners can lie inside an ear, so only they are tested. When no ear is found in a full turn
+// (self-intersecting or degenerate input) or the budget runs out, the current corner is clipped anyway.
+static void ear_clip(const std::vector<double>& x, const std::vector<double>& y, triangulate_state& st,
+                     std::vector<int>& tris) {
+  int n = int(x.size());
+  std::vector<int> prev(n), next(n);
+  std::vector<char> reflex(n), alive(n, 1);
+  std::vector<int> reflex_list;
+  for (int i = 0; i < n; i++) {
+    prev[i] = (i + n - 1) % n;
+    next[i] = (i + 1) % n;
+    reflex[i] = cross2(x.data(), y.data(), prev[i], i, next[i]) < 0;
+    if (reflex[i]) reflex_list.push_back(i);
+  }
+  bool out_of_budget = false;
+  int remaining = n, i = 0, misses = 0;
+  while (remaining > 3) {
+    int a = prev[i], b = next[i];
+    bool ear = false;
+    if (!out_of_budget && misses <= remaining && cross2(x.data(), y.data(), a, i, b) > 0) {
+      ear = true;
+      for (int r : reflex_list) {
+        st.budget--;
+        if (!alive[r] || !reflex[r] || r == a || r == i || r == b) continue;
+        bool same_point =
+            (x[r] == x[a] && y[r] == y[a]) || (x[r] == x[b] && y[r] == y[b]) || (x[r] == x[i] && y[r] == y[i]);
+        if (!same_point && in_triangle(x.data(), y.data(), a, i, b, r)) {
+          ear = false;
+          break;
+        }
+      }
+      if (st.budget < 0 && !out_of_budget) out_of_budget = true, st.fan_fallbacks++;
+    }
+    if (!ear && !out_of_budget && misses <= remaining) {
+      misses++;
+      i = b;
+      continue;
+    }
+    tris.insert(tris.end(), {a, i, b});
+    alive[i] = 0;
+    next[a] = b;
+    prev[b] = a;
+    remaining--;
+    for (int v : {a, b}) {
+      bool was = reflex[v];
+      reflex[v] = cross2(x.data(), y.data(), prev[v], v, next[v]) < 0;
+      if (reflex[v] && !was) reflex_list.push_back(v);
+    }
+    misses = 0;
+    i = a;
+  }
+  tris.insert(tris.end(), {prev[i], i, next[i]});
+}
+
+// Triangulates one polygon with corner positions p into n-2 triangles of local corner indices (winding kept).
+// Convex quads split along the shorter diagonal (as tinyobjloader does), other convex polygons fan from
+// corner 0, concave ones are ear-clipped in the plane of their Newell normal.
+static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& st, std::vector<int>& tris) {
+  int n = int(p.size());
+  tris.clear();
+  if (n == 3) return tris.assign({0, 1, 2});
+  // Newell normal (twice the vector area) relative to corner 0, in double for robust signs.
+  double nx = 0, ny = 0, nz = 0;
+  for (int i = 1; i + 1 < n; i++) {
+    double ax = double(p[i].x) - p[0].x, ay = double(p[i].y) - p[0].y, az = double(p[i].z) - p[0].z;
+    double bx = double(p[i + 1].x) - p[0].x, by = double(p[i + 1].y) - p[0].y, bz = double(p[i + 1].z) - p[0].z;
+    nx += ay * bz - az * by;
+    ny += az * bx - ax * bz;
+    nz += ax * by - ay * bx;
+  }
+  bool flat = !(std::fabs(nx) + std::fabs(ny) + std::fabs(nz) > 0) || !std::isfinite(nx + ny + nz);
+  // Project by dropping the dominant axis k, keeping the cyclic order of the other two (counter-clockwise).
+  int k =
+      std::fabs(nx) >= std::fabs(ny) && std::fabs(nx) >= std::fabs(nz) ? 0 : (std::fabs(ny) >= std::fabs(nz) ? 1 : 2);
+  double sign = (k == 0 ? nx : k == 1 ? ny : nz) < 0 ? -1.0 : 1.0;
+  std::vector<double> x(n), y(n);
+  for (int i = 0; i < n; i++) {
+    x[i] = sign * (double(p[i][(k + 1) % 3]) - p[0][(k + 1) % 3]);
+    y[i] = double(p[i][(k + 2) % 3]) - p[0][(k + 2) % 3];
+  }
+  bool convex = true;
+  for (int i = 0; i < n && convex && !flat; i++)
+    convex = cross2(x.data(), y.data(), (i + n - 1) % n, i, (i + 1) % n) >= 0;
+  if (flat || convex) {
+    if (n == 4) {
+      vec3f e02 = p[2] - p[0], e13 = p[3] - p[1];
+      if (length_sq(e02) < length_sq(e13)) return tris.assign({0, 1, 2, 0, 2, 3});
+      return tris.assign({0, 1, 3, 1, 2, 3});
+    }
+    for (int i = 1; i + 1 < n; i++) tris.insert(tris.end(), {0, i, i + 1});
+    return;
+  }
+  ear_clip(x, y, st, tris);
+}
+
+// True when triangle (a, b, c) has finite, non-zero area in float: |cross|^2 is a positive finite float.
+static bool good_triangle(vec3f a, vec3f b, vec3f c) {
+  vec3f n = cross(b - a, c - a);
+  float l2 = length_sq(n);
+  return is_finite(n) && l2 > 0 && l2 < inf_f;
+}
+
+// The unit normal along vn, or false when vn is zero or not finite (that corner then has no normal).
+static bool unit_normal(vec3f vn, vec3f& out) {
+  float m = max_abs_component(vn);
+  if (!(m > 0) || !(m < inf_f)) return false;
+  out = normalize(vn / m);  // scaled first so tiny normals do not underflow
+  return is_finite(out) && length_sq(out) > 0;
+}
+
+// The path of texture `name` named in MTL file mtl_path (relative names are relative to its folder;
+// Windows separators are tried as '/' when the name as written is not a file).
+static std::string texture_path(const std::string& mtl_path, const std::string& name) {
+  auto resolve = [&](const std::string& nm) {
+    fs::path q(nm);
+    if (!q.is_absolute()) q = fs::path(mtl_path).parent_path() / q;
+    return q.lexically_normal().string();
+  };
+  std::string path = resolve(name);
+  std::error_code ec;
+  if (name.find('\\') != std::string::npos && !fs::exists(path, ec)) {
+    std::string slashed = name;
+    for (char& ch : slashed) ch = ch == '\\' ? '/' : ch;
+    std::string alt = resolve(slashed);
+    if (fs::exists(alt, ec)) return alt;
+  }
+  return path;
+}
+
+// Index of the texture for (mtl, line, name) in mesh.textures, loading it on first use of its path.
+static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, const std::string& mtl_path, int line,
+                         const char* statement, const std::string& name) {
+  if (name.empty()) return invalid_id;
+  std::string path = texture_path(mtl_path, name);
+  auto it = loaded.find(path);
+  if (it != loaded.end()) return it->second;
+  try {
+    mesh.textures.push_back(load_texture(path));
+  } catch (const input_error& e) {
+    throw input_error(mtl_path, line, std::string(statement) + ": " + e.what());
+  }
+  loaded.emplace(path, int(mesh.textures.size()) - 1);
+  return int(mesh.textures.size()) - 1;
+}
+
+// Renumbers refs (invalid_id stays) to count only the referenced elements, in their original order; returns
+// the original index of each element kept.
+static std::vector<size_t> compact_refs(std::vector<int>& refs, size_t count) {
+  std::vector<int> remap(count, invalid_id);
+  for (int r : refs)
+    if (r >= 0) remap[size_t(r)] = 0;
+  std::vector<size_t> kept;
+  for (size_t i = 0; i < count; i++)
+    if (remap[i] == 0) remap[i] = int(kept.size()), kept.push_back(i);
+  for (int& r : refs)
+    if (r >= 0) r = remap[size_t(r)];
+  return kept;
+}
+
+// Parses the clean text with tinyobjloader and checks it read what the validator saw.
+static tinyobj::ObjReader parse_clean(const std::string& path, const obj_clean_data& clean) {
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = false;  // its ear clipping loses or flips triangles of concave polygons: we triangulate
+  config.vertex_color = false;
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromString(clean.obj_text, clean.mtl_text, config))
+    throw std::logic_error(path + ": tinyobjloader rejected validated text: " + reader.Error());
+  const auto& a = reader.GetAttrib();
+  size_t faces = 0, corners = 0;
+  bool same = a.vertices.size() == 3 * size_t(clean.vertex_count) &&
+              a.normals.size() == 3 * size_t(clean.normal_count) &&
+              a.texcoords.size() == 2 * size_t(clean.texcoord_count) && reader.GetShapes().size() <= 1;
+  for (const auto& s : reader.GetShapes()) {
+    for (size_t f = 0; same && f < s.mesh.num_face_vertices.size(); f++, faces++) {
+      same = faces < clean.face_sizes.size() && s.mesh.num_face_vertices[f] == (clean.face_sizes[faces] & 0xff) &&
+             s.mesh.material_ids[f] == clean.face_materials[faces];
+      corners += size_t(same ? clean.face_sizes[faces] : 0);
+    }
+    same = same && corners == s.mesh.indices.size();
+  }
+  if (!same || faces != clean.face_sizes.size())
+    throw std::logic_error(path + ": tinyobjloader read the validated OBJ differently (loader bug)");
+  return reader;
+}
+
+// Builds the mesh from the parsed OBJ: triangles, compacted vertex arrays, materials and textures.
+static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean, const tinyobj::ObjReader& reader) {
+  const auto& a = reader.GetAttrib();
+  auto position = [&](size_t i) { return vec3f{a.vertices[3 * i], a.vertices[3 * i + 1], a.vertices[3 * i + 2]}; };
+  std::vector<vec3f> normals(size_t(clean.normal_count));
+  std::vector<char> normal_ok(normals.size());
+  for (size_t i = 0; i < normals.size(); i++)
+    normal_ok[i] = unit_normal({a.normals[3 * i], a.normals[3 * i + 1], a.normals[3 * i + 2]}, normals[i]);
+
+  mesh_data mesh;
+  triangulate_state st;
+  std::vector<vec3f> corner_pos;
+  std::vector<int> local;
+  int default_material = int(clean.materials.size());
+  size_t face = 0;  // faces in file order across shapes (there is at most one shape)
+  for (const auto& s : reader.GetShapes()) {
+    size_t next_index = 0;
+    for (size_t f = 0; f < s.mesh.material_ids.size(); f++, face++) {
+      int n = clean.face_sizes[face];
+      const tinyobj::index_t* c = &s.mesh.indices[next_index];
+      next_index += size_t(n);
+      corner_pos.resize(size_t(n));
+      for (int i = 0; i < n; i++) corner_pos[size_t(i)] = position(size_t(c[i].vertex_index));
+      triangulate_polygon(corner_pos, st, local);
+      int material = s.mesh.material_ids[f] >= 0 ? s.mesh.material_ids[f] : default_material;
+      for (size_t t = 0; t < local.size(); t += 3) {
+        const tinyobj::index_t* tc[3] = {&c[local[t]], &c[local[t + 1]], &c[local[t + 2]]};
+        if (!good_triangle(position(size_t(tc[0]->vertex_index)), position(size_t(tc[1]->vertex_index)),
+                           position(size_t(tc[2]->vertex_index)))) {
+          mesh.dropped_degenerate++;
+          continue;
+        }
+        for (auto* x : tc) {
+          mesh.tri_positions.push_back(x->vertex_index);
+          bool has_n = x->normal_index >= 0 && normal_ok[size_t(x->normal_index)];
+          mesh.tri_normals.push_back(has_n ? x->normal_index : invalid_id);
+          mesh.tri_texcoords.push_back(x->texcoord_index >= 0 ? x->texcoord_index : invalid_id);
+        }
+        mesh.tri_materials.push_back(material);
+        if (mesh.tri_materials.size() > size_t(INT_MAX / 3)) throw input_error(path, "too many triangles");
+      }
+    }
+  }
+  if (st.fan_fallbacks > 0)
+    std::cerr << "warning: " << path << ": " << st.fan_fallbacks
+              << " polygon(s) too complex to ear-clip in the time budget were fan-triangulated\n";
+  if (mesh.tri_materials.empty())
+    throw input_error(path,
+                      "no triangles" + (mesh.dropped_degenerate > 0
+                                            ? " (" + std::to_string(mesh.dropped_degenerate) + " degenerate dropped)"
+                                            : std::string()));
+
+  // Compact each vertex array to the referenced elements, keeping file order.
+  for (size_t i : compact_refs(mesh.tri_positions, size_t(clean.vertex_count))) mesh.positions.push_back(position(i));
+  for (size_t i : compact_refs(mesh.tri_normals, normals.size())) mesh.normals.push_back(normals[i]);
+  for (size_t i : compact_refs(mesh.tri_texcoords, size_t(clean.texcoord_count))) {
+    float u = a.texcoords[2 * i], v = a.texcoords[2 * i + 1];
+    mesh.texcoords.push_back({std::isfinite(u) ? u : 0.0f, std::isfinite(v) ? v : 0.0f});
+  }
+
+  // Materials in order of first usemtl, then the default one if some face had none; textures once per path.
+  std::map<std::string, int> loaded;
+  for (const auto& m : clean.materials) {
+    material_data md = m.material;
+    md.kd_texture = texture_index(mesh, loaded, m.mtl_path, m.kd_map_line, "map_Kd", m.kd_map);
+    md.alpha_texture = texture_index(mesh, loaded, m.mtl_path, m.alpha_map_line, "map_d", m.alpha_map);
+    mesh.materials.push_back(md);
+  }
+  for (int m : mesh.tri_materials)
+    if (m == default_material) {
+      mesh.materials.push_back(material_data{});
+      mesh.materials.back().name = "default";
+      break;
+    }
+  return mesh;
+}
+
+mesh_data load_obj(const std::string& path) {
+  try {
+    obj_clean_data clean = validate_obj(path);
+    tinyobj::ObjReader reader = parse_clean(path, clean);
+    clean.obj_text = std::string();
+    return build_mesh(path, clean, reader);
+  } catch (const std::bad_alloc&) {
+    throw input_error(path, "out of memory while loading (input too large?)");
+  } catch (const std::length_error&) {
+    throw input_error(path, "input too large");
+  }
+}
+
+}  // namespace bl

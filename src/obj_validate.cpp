@@ -1,0 +1,434 @@
+// obj_validate: line-by-line checks of OBJ and MTL text, written to accept only what tinyobjloader parses
+// exactly as we read it (its number grammar, its index forms) and to name file and line on every rejection.
+// Invariants: lines end at \n, \r\n or a lone \r; a token starting with '#' starts a comment; tokens are split
+// at spaces, tabs, \v and \f; numbers are finite floats of at most max_number_chars characters and decimal
+// exponent at most 300 in magnitude; every index refers to an element defined earlier in the file.
+#include "obj_validate.h"
+
+#include "errors.h"
+#include "file_io.h"
+
+#include <climits>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+#include <string_view>
+
+namespace bl {
+
+namespace fs = std::filesystem;
+using std::string_view;
+
+// Where a statement is, for error messages.
+struct text_pos {
+  const std::string& file;
+  size_t line;
+};
+
+// Throws input_error at pos (lines beyond INT_MAX are reported as INT_MAX).
+[[noreturn]] static void fail(const text_pos& pos, const std::string& msg) {
+  throw input_error(pos.file, int(std::min<size_t>(pos.line, INT_MAX)), msg);
+}
+
+// A token quoted for a message: at most 40 characters, non-printable bytes shown as '?'.
+static std::string quote(string_view t) {
+  std::string q = "'";
+  for (size_t i = 0; i < t.size() && i < 40; i++) q += (t[i] >= 32 && t[i] < 127) ? t[i] : '?';
+  return q + (t.size() > 40 ? "...'" : "'");
+}
+
+std::string read_text_file(const std::string& path, const char* what) {
+  std::error_code ec;
+  auto status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) throw input_error(path, std::string("cannot open ") + what + ": no such file");
+  // Regular files only: a FIFO would block the read forever, a directory or device is not a scene file.
+  if (!fs::is_regular_file(status))
+    throw input_error(path, std::string("cannot open ") + what + ": not a regular file");
+  return read_file(path);
+}
+
+// Splits text into lines (\n, \r\n or lone \r), skipping a UTF-8 byte-order mark.
+struct line_reader {
+  const std::string& text;
+  size_t pos = 0;
+  size_t line = 0;
+  explicit line_reader(const std::string& t) : text(t) {
+    if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) pos = 3;
+  }
+  bool next(string_view& out) {
+    if (pos >= text.size()) return false;
+    size_t end = text.find_first_of("\r\n", pos);
+    if (end == std::string::npos) end = text.size();
+    out = string_view(text).substr(pos, end - pos);
+    pos = end + ((end + 1 < text.size() && text[end] == '\r' && text[end + 1] == '\n') ? 2 : 1);
+    line++;
+    return true;
+  }
+};
+
+// Splits a line into tokens, dropping a trailing comment; rejects NUL bytes.
+static void tokenize(string_view line, const text_pos& pos, std::vector<string_view>& tokens) {
+  tokens.clear();
+  if (line.find('\0') != string_view::npos) fail(pos, "NUL byte in text (binary file?)");
+  size_t i = 0, n = line.size();
+  auto is_sep = [](char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; };
+  while (i < n) {
+    while (i < n && is_sep(line[i])) i++;
+    if (i == n || line[i] == '#') return;
+    size_t b = i;
+    while (i < n && !is_sep(line[i])) i++;
+    tokens.push_back(line.substr(b, i - b));
+  }
+}
+
+// Tokens [first, end) joined by single spaces (names and file names that contain spaces).
+static std::string join_from(const std::vector<string_view>& t, size_t first) {
+  std::string s;
+  for (size_t i = first; i < t.size(); i++) (s += (i > first ? " " : "")) += t[i];
+  return s;
+}
+
+// True when t follows tinyobjloader's number grammar in full: [sign] (digits [. digits] | . digits)
+// [(e|E) [sign] digits], with a decimal exponent of at most 300 in magnitude.
+static bool number_grammar(string_view t, bool& exponent_too_big) {
+  size_t i = 0, n = t.size();
+  exponent_too_big = false;
+  if (i < n && (t[i] == '+' || t[i] == '-')) i++;
+  size_t digits = 0;
+  while (i < n && t[i] >= '0' && t[i] <= '9') i++, digits++;
+  if (i < n && t[i] == '.') {
+    i++;
+    while (i < n && t[i] >= '0' && t[i] <= '9') i++, digits++;
+  }
+  if (digits == 0) return false;
+  if (i < n && (t[i] == 'e' || t[i] == 'E')) {
+    i++;
+    if (i < n && (t[i] == '+' || t[i] == '-')) i++;
+    size_t exp_digits = 0;
+    long exponent = 0;
+    while (i < n && t[i] >= '0' && t[i] <= '9') {
+      exponent = std::min(exponent * 10 + (t[i] - '0'), 100000L);
+      i++, exp_digits++;
+    }
+    if (exp_digits == 0) return false;
+    exponent_too_big = exponent > 300;
+  }
+  return i == n;
+}
+
+// Parses t as a number (see number_grammar) into out; false (with a reason) when it is not one.
+static bool try_number(string_view t, float& out, std::string* why) {
+  bool too_big = false;
+  if (t.size() > size_t(max_number_chars)) {
+    if (why) *why = "number too long " + quote(t);
+    return false;
+  }
+  if (!number_grammar(t, too_big)) {
+    std::string lower;
+    for (char c : t) lower += char(std::tolower((unsigned char)c));
+    if (!lower.empty() && (lower[0] == '+' || lower[0] == '-')) lower.erase(0, 1);
+    bool special = lower == "nan" || lower == "inf" || lower == "infinity" || lower.compare(0, 4, "nan(") == 0;
+    if (why) *why = (special ? "non-finite number " : "malformed number ") + quote(t);
+    return false;
+  }
+  char buf[max_number_chars + 1];
+  std::memcpy(buf, t.data(), t.size());
+  buf[t.size()] = '\0';
+  out = too_big ? HUGE_VALF : std::strtof(buf, nullptr);  // correctly rounded, locale "C"
+  if (!std::isfinite(out)) {
+    if (why) *why = "number out of range " + quote(t);
+    return false;
+  }
+  return true;
+}
+
+// The number in token t, or an input_error at pos.
+static float number_at(string_view t, const text_pos& pos) {
+  float v = 0;
+  std::string why;
+  if (!try_number(t, v, &why)) fail(pos, why);
+  return v;
+}
+
+// Resolves one OBJ index component (1-based, negative = relative) against count elements defined so far.
+static void check_index(string_view t, int count, const char* what, const text_pos& pos) {
+  size_t i = (!t.empty() && (t[0] == '+' || t[0] == '-')) ? 1 : 0;
+  bool digits_only = i < t.size();
+  for (size_t k = i; k < t.size(); k++) digits_only = digits_only && t[k] >= '0' && t[k] <= '9';
+  if (!digits_only) fail(pos, std::string("malformed ") + what + " index " + quote(t));
+  long long v = 0;
+  for (size_t k = i; k < t.size(); k++) v = std::min(v * 10 + (t[k] - '0'), (long long)INT_MAX + 1);
+  if (t[0] == '-') v = -v;
+  if (v == 0) fail(pos, std::string(what) + " index 0 is invalid (OBJ indices start at 1)");
+  long long resolved = v > 0 ? v - 1 : count + v;
+  if (resolved < 0 || resolved >= count)
+    fail(pos, std::string(what) + " index " + quote(t) + " out of range (" + std::to_string(count) + " " +
+                  (count == 1                      ? what
+                   : std::string(what) == "vertex" ? "vertices"
+                                                   : std::string(what) + "s") +
+                  " defined so far)");
+}
+
+// Checks one face corner: v, v/vt, v//vn or v/vt/vn.
+static void check_corner(string_view c, const obj_clean_data& d, const text_pos& pos) {
+  size_t s1 = c.find('/');
+  if (s1 == string_view::npos) return check_index(c, d.vertex_count, "vertex", pos);
+  size_t s2 = c.find('/', s1 + 1);
+  if (s2 != string_view::npos && c.find('/', s2 + 1) != string_view::npos)
+    fail(pos, "malformed face corner " + quote(c) + " (expected v, v/vt, v//vn or v/vt/vn)");
+  check_index(c.substr(0, s1), d.vertex_count, "vertex", pos);
+  string_view vt = c.substr(s1 + 1, s2 == string_view::npos ? string_view::npos : s2 - s1 - 1);
+  if (s2 == string_view::npos || !vt.empty()) check_index(vt, d.texcoord_count, "texcoord", pos);
+  if (s2 != string_view::npos) check_index(c.substr(s2 + 1), d.normal_count, "normal", pos);
+}
+
+// Counts unrecognised statements of one file and reports them once.
+struct unknown_log {
+  int count = 0;
+  std::string first;
+  size_t first_line = 0;
+  void add(string_view keyword, size_t line) {
+    if (count++ == 0) first = quote(keyword), first_line = line;
+  }
+  void report(const std::string& file) const {
+    if (count > 0)
+      std::cerr << "warning: " << file << ": ignored " << count << " unrecognised statement" << (count > 1 ? "s" : "")
+                << " (first " << first << " at line " << first_line << ")\n";
+  }
+};
+
+// The path of file name `name` written in a file inside folder `dir`.
+static std::string resolve_path(const std::string& dir, const std::string& name) {
+  fs::path p(name);
+  if (!p.is_absolute() && !dir.empty()) p = fs::path(dir) / p;
+  return p.lexically_normal().string();
+}
+
+// Number of numeric arguments (min, max) of a texture option, or min = -1 when it takes one word.
+struct texture_option {
+  const char* name;
+  int min_args, max_args;
+};
+static const texture_option texture_options[] = {
+    {"-blendu", -1, 1}, {"-blendv", -1, 1},     {"-clamp", -1, 1}, {"-cc", -1, 1}, {"-imfchan", -1, 1},
+    {"-type", -1, 1},   {"-colorspace", -1, 1}, {"-boost", 1, 1},  {"-bm", 1, 1},  {"-texres", 1, 1},
+    {"-mm", 1, 2},      {"-o", 1, 3},           {"-s", 1, 3},      {"-t", 1, 3}};
+
+// Checks a texture statement (options, then a file name) and returns the file name.
+static std::string check_texture_statement(const std::vector<string_view>& t, const text_pos& pos) {
+  size_t i = 1;
+  while (i < t.size() && t[i].size() > 1 && t[i][0] == '-') {
+    const texture_option* opt = nullptr;
+    for (const auto& o : texture_options)
+      if (t[i] == o.name) opt = &o;
+    if (!opt) break;  // a file name that starts with '-'
+    string_view name = t[i++];
+    if (opt->min_args < 0) {
+      if (i >= t.size()) fail(pos, "texture option " + quote(name) + " needs a value");
+      bool on_off = name == "-blendu" || name == "-blendv" || name == "-clamp" || name == "-cc";
+      if (on_off && t[i] != "on" && t[i] != "off") fail(pos, "texture option " + quote(name) + " takes on or off");
+      i++;
+      continue;
+    }
+    for (int k = 0; k < opt->max_args; k++) {
+      float v = 0;
+      if (k < opt->min_args) {
+        if (i >= t.size()) fail(pos, "texture option " + quote(name) + " needs a number");
+        number_at(t[i], pos);
+      } else if (i >= t.size() || !try_number(t[i], v, nullptr)) {
+        break;
+      }
+      i++;
+    }
+  }
+  if (i >= t.size()) fail(pos, quote(t[0]) + " needs a file name");
+  return join_from(t, i);
+}
+
+// Checks a colour statement (1 or 3 finite non-negative numbers) and returns it.
+static vec3f colour_at(const std::vector<string_view>& t, const text_pos& pos) {
+  if (t.size() != 2 && t.size() != 4)
+    fail(pos, quote(t[0]) + " takes 1 or 3 numbers, got " + std::to_string(t.size() - 1));
+  vec3f c;
+  for (size_t i = 1; i < t.size(); i++) {
+    float v = number_at(t[i], pos);
+    if (v < 0) fail(pos, quote(t[0]) + " must not be negative");
+    c[int(i - 1)] = v;
+  }
+  return t.size() == 2 ? vec3f{c.x, c.x, c.x} : c;
+}
+
+// Checks a scalar statement (one finite number) and returns it.
+static float scalar_at(const std::vector<string_view>& t, const text_pos& pos) {
+  if (t.size() != 2) fail(pos, quote(t[0]) + " takes 1 number, got " + std::to_string(t.size() - 1));
+  return number_at(t[1], pos);
+}
+
+// Validates one MTL file, appending its materials (file order) to out.
+static void validate_mtl(const std::string& path, std::vector<mtl_material_data>& out) {
+  std::string text = read_text_file(path, "material library");
+  line_reader lines(text);
+  std::vector<string_view> t;
+  string_view line;
+  unknown_log unknown;
+  mtl_material_data* cur = nullptr;
+  while (lines.next(line)) {
+    text_pos pos{path, lines.line};
+    tokenize(line, pos, t);
+    if (t.empty()) continue;
+    string_view k = t[0];
+    if (k == "newmtl") {
+      if (t.size() < 2) fail(pos, "newmtl needs a material name");
+      out.emplace_back();
+      cur = &out.back();
+      cur->material.name = join_from(t, 1);
+      cur->mtl_path = path;
+      continue;
+    }
+    bool texture =
+        k.compare(0, 4, "map_") == 0 || k == "bump" || k == "disp" || k == "decal" || k == "refl" || k == "norm";
+    bool known = texture || k == "Kd" || k == "Ks" || k == "Ke" || k == "Ka" || k == "Tf" || k == "Kt" || k == "Ns" ||
+                 k == "Ni" || k == "d" || k == "Tr" || k == "illum";
+    if (!known) {
+      unknown.add(k, lines.line);
+      continue;
+    }
+    if (!cur) fail(pos, quote(k) + " before any newmtl");
+    material_data& m = cur->material;
+    if (texture) {
+      std::string file = check_texture_statement(t, pos);
+      if (k == "map_Kd") cur->kd_map = file, cur->kd_map_line = int(std::min<size_t>(lines.line, INT_MAX));
+      if (k == "map_d") cur->alpha_map = file, cur->alpha_map_line = int(std::min<size_t>(lines.line, INT_MAX));
+    } else if (k == "Kd" || k == "Ks" || k == "Ke" || k == "Ka" || k == "Tf" || k == "Kt") {
+      vec3f c = colour_at(t, pos);
+      if (k == "Kd") m.kd = c;
+      if (k == "Ks") m.ks = c;
+      if (k == "Ke") m.ke = c;
+    } else {
+      float v = scalar_at(t, pos);
+      if (k == "Ns" && v < 0) fail(pos, "Ns must not be negative");
+      if ((k == "d" || k == "Tr") && !(v >= 0 && v <= 1)) fail(pos, quote(k) + " must lie in [0, 1]");
+      if (k == "Ns") m.ns = v;
+    }
+  }
+  unknown.report(path);
+}
+
+// Per-OBJ state of the validation pass beside the output.
+struct obj_pass_state {
+  std::map<std::string, int> used_index;   // usemtl name -> k
+  std::vector<std::string> used_names;     // k -> name
+  std::vector<size_t> used_lines;          // k -> line of its first usemtl
+  std::set<std::string> mtl_files;         // resolved MTL paths already read
+  std::vector<mtl_material_data> defined;  // all materials of all MTL files, in load order
+};
+
+// Handles an mtllib statement: every named file must exist; each file is read once.
+static void handle_mtllib(const std::vector<string_view>& t, const std::string& dir, obj_pass_state& st,
+                          const text_pos& pos) {
+  if (t.size() < 2) fail(pos, "mtllib needs a file name");
+  std::vector<std::string> names;
+  std::string whole = join_from(t, 1);
+  std::error_code ec;
+  if (t.size() > 2 && fs::is_regular_file(resolve_path(dir, whole), ec)) {
+    names.push_back(whole);  // one file name with spaces in it
+  } else {
+    for (size_t i = 1; i < t.size(); i++) names.emplace_back(t[i]);
+  }
+  for (const auto& name : names) {
+    std::string file = resolve_path(dir, name);
+    if (!st.mtl_files.insert(file).second) continue;
+    try {
+      validate_mtl(file, st.defined);
+    } catch (const input_error& e) {
+      if (e.line > 0) throw;
+      fail(pos, std::string("mtllib: ") + e.what());  // the MTL itself is unreadable: point at this line
+    }
+  }
+}
+
+obj_clean_data validate_obj(const std::string& path) {
+  std::string text = read_text_file(path, "OBJ file");
+  std::string dir = fs::path(path).parent_path().string();
+  obj_clean_data d;
+  obj_pass_state st;
+  unknown_log unknown;
+  std::string body;  // the clean statements after the mtllib line
+  body.reserve(text.size());
+  int current = invalid_id;  // material k of the next faces
+  line_reader lines(text);
+  std::vector<string_view> t;
+  string_view line;
+  while (lines.next(line)) {
+    text_pos pos{path, lines.line};
+    tokenize(line, pos, t);
+    if (t.empty()) continue;
+    string_view k = t[0];
+    size_t args = t.size() - 1;
+    if (k == "v" || k == "vn" || k == "vt") {
+      bool ok = k == "v" ? (args == 3 || args == 4 || args == 6) : k == "vn" ? args == 3 : (args >= 1 && args <= 3);
+      if (!ok)
+        fail(pos, quote(k) +
+                      (k == "v"    ? " takes 3 numbers (or x y z w, or x y z r g b)"
+                       : k == "vn" ? " takes 3 numbers"
+                                   : " takes 1 to 3 numbers") +
+                      ", got " + std::to_string(args));
+      for (size_t i = 1; i <= args; i++) number_at(t[i], pos);
+      int& count = k == "v" ? d.vertex_count : k == "vn" ? d.normal_count : d.texcoord_count;
+      if (count == INT_MAX - 1) fail(pos, "too many " + std::string(k) + " statements");
+      count++;
+      size_t keep = k == "vt" ? std::min<size_t>(args, 2) : 3;
+      body += k;
+      for (size_t i = 1; i <= keep; i++) (body += ' ') += t[i];
+      body += '\n';
+    } else if (k == "f") {
+      if (args < 3) fail(pos, "a face needs at least 3 vertices, got " + std::to_string(args));
+      if (args > size_t(INT_MAX / 4)) fail(pos, "face has too many vertices");
+      body += 'f';
+      for (size_t i = 1; i <= args; i++) {
+        check_corner(t[i], d, pos);
+        (body += ' ') += t[i];
+      }
+      body += '\n';
+      d.face_sizes.push_back(int(args));
+      d.face_materials.push_back(current);
+    } else if (k == "usemtl") {
+      if (args < 1) fail(pos, "usemtl needs a material name");
+      std::string name = join_from(t, 1);
+      auto it = st.used_index.emplace(name, int(st.used_names.size())).first;
+      if (it->second == int(st.used_names.size())) {
+        st.used_names.push_back(name);
+        st.used_lines.push_back(lines.line);
+      }
+      current = it->second;
+      body += "usemtl u" + std::to_string(current) + "\n";
+    } else if (k == "mtllib") {
+      handle_mtllib(t, dir, st, pos);
+    } else if (k == "o" || k == "g" || k == "s" || k == "l" || k == "p" || k == "vp") {
+      // Accepted and not needed: groups, smoothing, lines, points, parameter-space vertices.
+    } else {
+      unknown.add(k, lines.line);
+    }
+  }
+  unknown.report(path);
+  text = std::string();
+
+  // Resolve the used names (first definition wins, as in tinyobjloader) in order of first use.
+  std::map<std::string, int> defined_index;
+  for (size_t i = 0; i < st.defined.size(); i++) defined_index.emplace(st.defined[i].material.name, int(i));
+  for (size_t k = 0; k < st.used_names.size(); k++) {
+    auto it = defined_index.find(st.used_names[k]);
+    if (it == defined_index.end())
+      fail(text_pos{path, st.used_lines[k]}, "usemtl of undefined material " + quote(st.used_names[k]));
+    d.materials.push_back(st.defined[size_t(it->second)]);
+    d.mtl_text += "newmtl u" + std::to_string(k) + "\n";
+  }
+  d.obj_text = d.materials.empty() ? std::move(body) : "mtllib used.mtl\n" + body;
+  return d;
+}
+
+}  // namespace bl

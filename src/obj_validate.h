@@ -1,0 +1,43 @@
+// obj_validate: the first pass of the OBJ loader. Reads the OBJ and every MTL it names exactly once, checks
+// each statement with its line number, and writes clean text for tinyobjloader plus the parsed materials.
+// Invariants: any input ends in an obj_clean_data or an input_error; the clean text holds only v, vn, vt, f
+// and usemtl statements (one per line, comments gone, every number and index already checked) and at most one
+// mtllib, so tinyobjloader parses exactly what was validated. Unrecognised statements are counted and reported
+// once per file on stderr.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "obj_io.h"
+
+namespace bl {
+
+// One material as read from an MTL file, with where its texture statements were (for error messages).
+struct mtl_material_data {
+  material_data material;         // kd, ks, ns, ke, name; texture ids still invalid_id
+  std::string kd_map, alpha_map;  // map_Kd / map_d file names as written ("" when absent)
+  int kd_map_line = 0, alpha_map_line = 0;
+  std::string mtl_path;  // the MTL file that defined it (texture paths are relative to its folder)
+};
+
+// The validated OBJ: clean text for tinyobjloader and what the conversion needs beside it.
+struct obj_clean_data {
+  std::string obj_text;                      // v/vn/vt/f lines, "usemtl u<k>", "mtllib used.mtl" first if any
+  std::string mtl_text;                      // "newmtl u<k>" for k = 0..materials.size()-1
+  std::vector<mtl_material_data> materials;  // used materials; k = order of first usemtl in the OBJ
+  std::vector<int> face_sizes;               // corners of each face, in file order
+  std::vector<int> face_materials;           // k of each face, or invalid_id before any usemtl
+  int vertex_count = 0, normal_count = 0, texcoord_count = 0;
+};
+
+// Longest accepted number token (real files write at most ~25 characters).
+constexpr int max_number_chars = 128;
+
+// Reads and validates the OBJ at path and its MTL libraries; throws input_error naming file and line.
+obj_clean_data validate_obj(const std::string& path);
+
+// Reads a whole regular file; throws input_error (naming what, e.g. "material library") when it cannot.
+std::string read_text_file(const std::string& path, const char* what);
+
+}  // namespace bl

@@ -1,0 +1,47 @@
+// progress: a progress bar on stderr (only when stderr is a terminal), redrawn by its own thread from
+// atomic counters the render loop updates; it never touches render data, so it cannot change an image.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+namespace bl {
+
+// Counters shown by the bar; written by the render loop, read by the bar's thread.
+struct progress_counters {
+  std::atomic<int> pass{0};
+  std::atomic<int> spp_done{0};
+  std::atomic<int> spp_target{0};       // 0 when rendering against a time budget
+  std::atomic<double> time_budget{0};
+  std::atomic<int> rows_done{0};        // rows of the running pass
+  std::atomic<int> rows{1};
+  std::atomic<int> pass_spp{0};         // samples per pixel of the running pass
+};
+
+// A running progress bar; stops and clears its line when destroyed.
+class progress_bar {
+ public:
+  progress_bar(progress_counters& counters, bool enabled);
+  ~progress_bar();
+  progress_bar(const progress_bar&) = delete;
+  progress_bar& operator=(const progress_bar&) = delete;
+
+ private:
+  void run();
+  void draw(bool final_line);
+  progress_counters& counters_;
+  bool enabled_;
+  std::chrono::steady_clock::time_point start_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+// Whether stderr is a terminal.
+bool stderr_is_terminal();
+
+}  // namespace bl

@@ -1,0 +1,233 @@
+// region_grid: grid levels, keys, the lookup table, region creation under a pair budget, and light cuts.
+#include "region_grid.h"
+
+#include "rng.h"
+
+#include <algorithm>
+#include <queue>
+
+namespace bl {
+
+namespace {
+
+// Key layout: 2 bits level | 20 bits k | 21 bits j | 21 bits i (cells per axis are capped at 2^20).
+constexpr int max_cells_per_axis = 1 << 20;
+
+uint64_t make_key(int level, int i, int j, int k) {
+  return (uint64_t(level) << 62) | (uint64_t(k) << 42) | (uint64_t(j) << 21) | uint64_t(i);
+}
+int key_level(uint64_t key) { return int(key >> 62); }
+void key_cell(uint64_t key, int& i, int& j, int& k) {
+  i = int(key & 0x1fffff);
+  j = int((key >> 21) & 0x1fffff);
+  k = int((key >> 42) & 0xfffff);
+}
+
+void table_insert(region_state& s, uint64_t key, int id) {
+  size_t mask = s.table_key.size() - 1;
+  size_t h = size_t(mix64(key)) & mask;
+  while (s.table_key[h] != empty_region_key) h = (h + 1) & mask;
+  s.table_key[h] = key;
+  s.table_id[h] = id;
+}
+
+// Grows the table to keep its load at most 1/2 for `regions` entries.
+void reserve_table(region_state& s, size_t regions) {
+  size_t want = 16;
+  while (want < 2 * regions) want *= 2;
+  if (want <= s.table_key.size()) return;
+  s.table_key.assign(want, empty_region_key);
+  s.table_id.assign(want, invalid_id);
+  for (size_t r = 0; r < s.key.size(); r++) table_insert(s, s.key[r], int(r));
+}
+
+// Appends a region with the given cut (or the shared cut 0).
+int append_region(region_state& s, uint64_t key, const std::vector<int>* cut) {
+  int id = int(s.key.size());
+  s.key.push_back(key);
+  if (cut) {
+    s.cut_offset.push_back(int(s.cut_nodes.size()));
+    s.cut_size.push_back(int(cut->size()));
+    s.cut_nodes.insert(s.cut_nodes.end(), cut->begin(), cut->end());
+  } else {
+    s.cut_offset.push_back(0);
+    s.cut_size.push_back(s.cut_size.empty() ? 0 : s.cut_size[0]);
+  }
+  s.pair_offset.push_back(int(s.pairs));
+  s.pairs += s.cut_size.back();
+  reserve_table(s, s.key.size());
+  table_insert(s, key, id);
+  return id;
+}
+
+// Bounds are evaluated over the cell grown by a small margin, so points that round onto a neighbouring cell
+// are still covered by the conservative bound.
+bbox3f padded(const bbox3f& b) {
+  vec3f m = extent(b) * 1e-3f;
+  return {b.lo - m, b.hi + m};
+}
+
+}  // namespace
+
+region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree, bool has_sun,
+                               const region_params& params) {
+  region_state s;
+  s.params = params;
+  s.has_sun = has_sun;
+  region_grid_data& g = s.grid;
+  bbox3f b = is_empty(bounds) ? bbox3f{{0, 0, 0}, {1, 1, 1}} : bounds;
+  vec3f ext = extent(b);
+  float longest = std::max(max_component(ext), 1e-20f);
+  float shortest = std::min(ext.x, std::min(ext.y, ext.z));
+  // A flat scene has no shortest extent: use a thousandth of the longest one instead.
+  shortest = std::max(shortest, 1e-3f * longest);
+  float cell = shortest / float(std::max(1, params.grid));
+  cell = std::max(cell, longest / float(max_cells_per_axis - 1));
+  g.origin = b.lo;
+  g.cell[0] = cell;
+  g.cell[1] = cell * 8;
+  g.cell[2] = longest * 1.001f;
+  for (int l = 0; l < region_levels; l++)
+    for (int a = 0; a < 3; a++)
+      g.dims[l][a] = l == 2 ? 1 : std::max(1, std::min(max_cells_per_axis, int(std::ceil(ext[a] / g.cell[l])) + 1));
+  std::vector<int> all;
+  int leaves = (node_count(tree) + 1) / 2;
+  if (node_count(tree) > 0 && leaves <= params.max_cut) {
+    // A handful of lights: one cut of all lights serves every region.
+    s.shared_cut = true;
+    for (int n = 0; n < node_count(tree); n++)
+      if (is_leaf(tree, n)) all.push_back(n);
+    if (has_sun) all.push_back(sun_cluster);
+  }
+  uint64_t root_key = make_key(2, 0, 0, 0);
+  if (s.shared_cut) append_region(s, root_key, &all);
+  else {
+    std::vector<int> cut = compute_light_cut(tree, padded(b), has_sun, params);
+    append_region(s, root_key, &cut);
+  }
+  s.root = 0;
+  return s;
+}
+
+uint64_t fine_region_key(const region_grid_data& g, vec3f p) {
+  int c[3];
+  for (int a = 0; a < 3; a++) {
+    float f = (p[a] - g.origin[a]) / g.cell[0];
+    int v = f >= 0 ? (f < float(g.dims[0][a]) ? int(f) : g.dims[0][a] - 1) : 0;  // NaN lands in cell 0
+    c[a] = v;
+  }
+  return make_key(0, c[0], c[1], c[2]);
+}
+
+uint64_t parent_region_key(const region_grid_data& g, uint64_t fine_key, int level) {
+  if (level >= 2) return make_key(2, 0, 0, 0);
+  int i, j, k;
+  key_cell(fine_key, i, j, k);
+  int f = level == 1 ? 8 : 1;
+  return make_key(level, std::min(i / f, g.dims[level][0] - 1), std::min(j / f, g.dims[level][1] - 1),
+                  std::min(k / f, g.dims[level][2] - 1));
+}
+
+bbox3f region_box(const region_grid_data& g, uint64_t key) {
+  int level = key_level(key);
+  if (level >= 2) return {g.origin, g.origin + vec3f{g.cell[2], g.cell[2], g.cell[2]}};
+  int i, j, k;
+  key_cell(key, i, j, k);
+  float c = g.cell[level];
+  vec3f lo = g.origin + vec3f{float(i) * c, float(j) * c, float(k) * c};
+  return {lo, lo + vec3f{c, c, c}};
+}
+
+int find_region_key(const region_state& s, uint64_t key) {
+  size_t mask = s.table_key.size() - 1;
+  for (size_t h = size_t(mix64(key)) & mask;; h = (h + 1) & mask) {
+    uint64_t k = s.table_key[h];
+    if (k == key) return s.table_id[h];
+    if (k == empty_region_key) return invalid_id;
+  }
+}
+
+int find_region(const region_state& s, uint64_t fine_key) {
+  int r = find_region_key(s, fine_key);
+  if (r != invalid_id) return r;
+  r = find_region_key(s, parent_region_key(s.grid, fine_key, 1));
+  return r != invalid_id ? r : s.root;
+}
+
+int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys) {
+  int added = 0;
+  int64_t per_region = s.cut_size.empty() ? 1 : std::max(1, s.shared_cut ? s.cut_size[0] : s.params.max_cut + 1);
+  std::vector<uint64_t> coarse;
+  for (uint64_t key : fine_keys) {
+    if (find_region_key(s, key) != invalid_id) continue;
+    if (s.pairs + per_region > s.params.max_pairs) {
+      coarse.push_back(parent_region_key(s.grid, key, 1));
+      continue;
+    }
+    if (s.shared_cut) append_region(s, key, nullptr);
+    else {
+      std::vector<int> cut = compute_light_cut(tree, padded(region_box(s.grid, key)), s.has_sun, s.params);
+      append_region(s, key, &cut);
+    }
+    added++;
+  }
+  // Over budget: coarse cells serve the rest (they may exceed the budget by at most 1/512 of the fine cells).
+  std::sort(coarse.begin(), coarse.end());
+  coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
+  for (uint64_t key : coarse) {
+    if (find_region_key(s, key) != invalid_id) continue;
+    if (s.shared_cut) append_region(s, key, nullptr);
+    else {
+      std::vector<int> cut = compute_light_cut(tree, padded(region_box(s.grid, key)), s.has_sun, s.params);
+      append_region(s, key, &cut);
+    }
+    added++;
+  }
+  return added;
+}
+
+std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool has_sun, const region_params& p) {
+  std::vector<int> cut;
+  if (node_count(tree) > 0) {
+    // Max-heap of (bound, node); ties go to the smaller node id so the cut is a function of the box only.
+    using entry = std::pair<float, int>;
+    auto less = [](const entry& a, const entry& b) { return a.first < b.first || (a.first == b.first && a.second > b.second); };
+    std::priority_queue<entry, std::vector<entry>, decltype(less)> heap(less);
+    float root_bound = node_region_bound(tree, 0, box.lo, box.hi);
+    if (root_bound > 0) heap.push({root_bound, 0});
+    double total = root_bound;
+    while (!heap.empty()) {
+      entry top = heap.top();
+      if (is_leaf(tree, top.second)) {
+        heap.pop();
+        cut.push_back(top.second);
+        continue;
+      }
+      if (int(cut.size() + heap.size()) >= p.max_cut) break;
+      if (double(top.first) <= double(p.cut_threshold) * total) break;
+      heap.pop();
+      total -= top.first;
+      for (int child : {tree.left[size_t(top.second)], tree.right[size_t(top.second)]}) {
+        float b = node_region_bound(tree, child, box.lo, box.hi);
+        if (b > 0) {
+          heap.push({b, child});
+          total += b;
+        }
+      }
+    }
+    while (!heap.empty()) {
+      cut.push_back(heap.top().second);
+      heap.pop();
+    }
+    std::sort(cut.begin(), cut.end());
+  }
+  if (has_sun) cut.push_back(sun_cluster);
+  return cut;
+}
+
+size_t region_memory_bytes(const region_state& s) {
+  return s.key.size() * (sizeof(uint64_t) + 3 * sizeof(int)) + s.cut_nodes.size() * sizeof(int) +
+         s.table_key.size() * (sizeof(uint64_t) + sizeof(int));
+}
+
+}  // namespace bl

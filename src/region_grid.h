@@ -1,0 +1,82 @@
+// region_grid: the sparse uniform grid of regions over the scene bounds, and each region's light cut.
+// Three levels: fine cells (`grid` cells along the shortest axis of the bounds), coarse cells (8x8x8 fine
+// cells) and the root (the whole scene). Only regions that shading points reach exist; a point uses the
+// finest existing region containing it. Invariants: regions are created only between passes, from requests
+// in a deterministic order, so region content and ids never depend on thread timing; the root always
+// exists; the total number of (region, cluster) pairs stays under `max_pairs` (then coarser regions serve).
+// Keys are 64-bit (level, i, j, k) hashed with a strong mixer in an open-addressing table (load <= 1/2).
+#pragma once
+
+#include "light_tree.h"
+#include "math.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace bl {
+
+// Options of regions and cuts.
+struct region_params {
+  int grid = 64;                   // fine cells along the shortest axis of the scene bounds
+  int max_cut = 64;                // clusters per region (the sun, if any, comes on top)
+  float cut_threshold = 0.005f;    // stop refining when every cluster bound < threshold * total
+  int64_t max_pairs = int64_t(1) << 23;  // memory budget in (region, cluster) pairs
+};
+
+// Cluster id of the sun inside a cut (tree nodes are >= 0).
+constexpr int sun_cluster = -2;
+constexpr int region_levels = 3;  // fine, coarse, root
+
+// Geometry of the grid levels.
+struct region_grid_data {
+  vec3f origin;
+  float cell[region_levels];
+  int dims[region_levels][3];
+};
+
+// Regions as flat columns, plus the key -> region lookup table.
+struct region_state {
+  region_grid_data grid;
+  region_params params;
+  bool has_sun = false;
+  bool shared_cut = false;             // few lights: every region uses cut 0 (all lights), no clustering
+  std::vector<uint64_t> key;           // per region
+  std::vector<int> cut_offset;         // per region: first entry in cut_nodes
+  std::vector<int> cut_size;           // per region
+  std::vector<int> pair_offset;        // per region: its first (region, cluster) pair
+  std::vector<int> cut_nodes;          // concatenated sorted cuts (tree node ids, then sun_cluster)
+  int64_t pairs = 0;                   // total (region, cluster) pairs
+  std::vector<uint64_t> table_key;     // open addressing; empty slots hold empty_key
+  std::vector<int> table_id;
+  int root = 0;
+};
+
+constexpr uint64_t empty_region_key = ~uint64_t(0);
+
+// Builds the grid over `bounds` with the root region (and, for few lights, the shared cut).
+region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree, bool has_sun,
+                               const region_params& params);
+
+// Key of the fine cell containing p.
+uint64_t fine_region_key(const region_grid_data& g, vec3f p);
+// Key of the cell of `level` containing the fine cell `fine_key`.
+uint64_t parent_region_key(const region_grid_data& g, uint64_t fine_key, int level);
+// Box of the cell with this key.
+bbox3f region_box(const region_grid_data& g, uint64_t key);
+// Region id of a key, or invalid_id.
+int find_region_key(const region_state& s, uint64_t key);
+// The finest existing region containing the fine cell `fine_key` (the root at worst).
+int find_region(const region_state& s, uint64_t fine_key);
+
+// Creates regions for requested fine keys (sorted, deduplicated by the caller): fine regions while the
+// pair budget allows, then their coarse parents. Returns the number of regions added.
+int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys);
+
+// The light cut of a box: tree nodes sorted by id (then sun_cluster if has_sun), Lightcuts-style refinement of
+// conservative bounds; nodes that cannot light any point of the box are left out.
+std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool has_sun, const region_params& p);
+
+// Bytes used by the region state (columns and table).
+size_t region_memory_bytes(const region_state& s);
+
+}  // namespace bl

@@ -1,0 +1,209 @@
+// render: pass schedule, parallel pass execution over image rows, film folding, learning, error log.
+#include "render.h"
+
+#include "progress.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <chrono>
+#include <climits>
+#include <csignal>
+#include <thread>
+
+namespace bl {
+
+namespace {
+
+std::atomic<int> g_signal{0};
+
+extern "C" void on_interrupt(int sig) { g_signal.store(sig); }
+
+using clock_type = std::chrono::steady_clock;
+double seconds_since(clock_type::time_point t) {
+  return std::chrono::duration<double>(clock_type::now() - t).count();
+}
+
+// Per-row outputs of one pass: the row's sample sums go straight to the pass buffer; a learning sampler's
+// row states and the counters are kept per row so that folding them in row order is independent of which
+// thread ran which row.
+template <class Sampler>
+struct pass_rows {
+  std::vector<path_stats> stats;
+  std::vector<typename Sampler::row_state> records;
+};
+struct pass_rows_none {
+  std::vector<path_stats> stats;
+};
+
+// Hands a learning sampler's NEE events to its state of one row.
+template <class Sampler>
+struct row_sink {
+  const Sampler* sampler;
+  typename Sampler::row_state* row;
+  template <class Event>
+  void record(const Event& e) {
+    sampler->record(*row, e);
+  }
+};
+
+// Renders samples [s0, s1) of every pixel into pass_sum; false when interrupted (the pass is then void).
+template <class Sampler, class Rows>
+bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, std::vector<double>& pass_sum,
+              Rows& rows, tbb::task_arena& arena, progress_counters& progress) {
+  int w = in.camera.width, h = in.camera.height;
+  std::atomic<bool> stopped{false};
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, h, 1), [&](const tbb::blocked_range<int>& range) {
+      for (int y = range.begin(); y < range.end(); y++) {
+        if (g_signal.load(std::memory_order_relaxed) != 0) {
+          stopped = true;
+          return;
+        }
+        path_stats& st = rows.stats[size_t(y)];
+        st = {};
+        auto render_row = [&](auto& sink) {
+          for (int x = 0; x < w; x++) {
+            double sum[3] = {0, 0, 0};
+            for (int s = s0; s < s1; s++) {
+              vec3f l = trace_path(in, sampler, x, y, uint64_t(s), st, sink);
+              sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
+            }
+            double* out = &pass_sum[3 * (size_t(y) * w + x)];
+            out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
+          }
+        };
+        if constexpr (Sampler::learns) {
+          auto& row = rows.records[size_t(y)];
+          row.clear();
+          row_sink<Sampler> sink{&sampler, &row};
+          render_row(sink);
+        } else {
+          null_sink sink;
+          render_row(sink);
+        }
+        progress.rows_done.fetch_add(1, std::memory_order_relaxed);
+      }
+    });
+  });
+  return !stopped;
+}
+
+// Error of the film's current mean against the reference.
+error_metrics film_error(const std::vector<double>& film, int spp, const image_data& ref) {
+  std::vector<float> img(film.size());
+  for (size_t i = 0; i < film.size(); i++) img[i] = float(film[i] / spp);
+  return compute_error(img.data(), ref.pixels.data(), img.size());
+}
+
+// The pass loop for one sampler type.
+template <class Sampler>
+void render_with(const render_inputs& in, Sampler& sampler, const render_params& params, render_result& result) {
+  int w = params.width, h = params.height;
+  size_t n = size_t(w) * size_t(h) * 3;
+  result.film.assign(n, 0.0);
+  std::vector<double> pass_sum(n, 0.0);
+  using rows_type = std::conditional_t<Sampler::learns, pass_rows<Sampler>, pass_rows_none>;
+  rows_type rows;
+  rows.stats.resize(size_t(h));
+  if constexpr (Sampler::learns) rows.records.resize(size_t(h));
+
+  int threads = params.threads > 0 ? params.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  tbb::task_arena arena(threads);
+  progress_counters progress;
+  progress.spp_target = params.time_budget > 0 ? 0 : params.spp;
+  progress.time_budget = params.time_budget;
+  progress.rows = h;
+  progress_bar bar(progress, params.progress);
+
+  const int target = params.time_budget > 0 ? INT_MAX : params.spp;
+  int done = 0;
+  for (int pass = 0; done < target; pass++) {
+    if (params.time_budget > 0 && result.seconds >= params.time_budget) break;
+    if (g_signal.load() != 0) {
+      result.interrupted = true;
+      break;
+    }
+    int count = std::min(pass_size(pass, done), target - done);
+    progress.pass = pass + 1;
+    progress.pass_spp = count;
+    progress.rows_done = 0;
+    auto t0 = clock_type::now();
+    if (!run_pass(in, sampler, done, done + count, pass_sum, rows, arena, progress)) {
+      result.interrupted = true;
+      break;
+    }
+    for (size_t i = 0; i < n; i++) result.film[i] += pass_sum[i];
+    for (const path_stats& st : rows.stats) add_stats(result.stats, st);
+    if constexpr (Sampler::learns) sampler.learn(rows.records);
+    else sampler.end_pass();
+    result.seconds += seconds_since(t0);
+    done += count;
+    result.spp = done;
+    result.passes = pass + 1;
+    progress.spp_done = done;
+    progress.pass_spp = 0;
+
+    pass_record rec;
+    rec.pass = pass + 1;
+    rec.spp = done;
+    rec.seconds = result.seconds;
+    if (params.reference) {
+      rec.has_error = true;
+      rec.error = film_error(result.film, done, *params.reference);
+    }
+    result.log.push_back(rec);
+  }
+}
+
+}  // namespace
+
+int pass_size(int pass, int done) {
+  // 1 spp per pass while learning matters most, then passes of 1/8 of the samples so far (the error log
+  // gets log-spaced points, learning updates stay frequent), at most 64 spp.
+  if (pass < 8) return 1;
+  return std::min(64, std::max(1, done / 8));
+}
+
+render_result render(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
+                     const render_params& params) {
+  render_result result;
+  result.width = params.width;
+  result.height = params.height;
+  render_inputs in;
+  in.scene = &scene;
+  in.bvh = &bvh;
+  in.lights = &lights;
+  in.camera = make_camera(scene.camera, params.width, params.height);
+  in.max_depth = params.max_depth;
+  in.seed = params.seed;
+  auto t0 = clock_type::now();
+  light_tree_data tree;
+  if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
+  light_sampler sampler = make_light_sampler(params.sampler, in, tree);
+  result.setup_seconds = seconds_since(t0);
+  std::visit([&](auto& s) { render_with(in, s, params, result); }, sampler);
+  result.sampler_bytes = sampler_memory_bytes(sampler);
+  return result;
+}
+
+image_data film_image(const render_result& r) {
+  image_data img;
+  img.width = r.width;
+  img.height = r.height;
+  img.pixels.assign(r.film.size(), 0.0f);
+  if (r.spp > 0)
+    for (size_t i = 0; i < r.film.size(); i++) img.pixels[i] = float(r.film[i] / r.spp);
+  return img;
+}
+
+void install_interrupt_handlers() {
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+}
+int interrupt_signal() { return g_signal.load(); }
+void reset_interrupt() { g_signal.store(0); }
+
+}  // namespace bl

@@ -1,0 +1,72 @@
+// render: the pass loop — renders passes of whole samples per pixel in parallel, folds each completed pass
+// into the film, lets adaptive samplers learn between passes, and logs error against wall time.
+// Invariants: the work of a pass is split into a fixed partition (one chunk per image row) that does not
+// depend on the thread count; every pixel's samples are summed in sample order; the film only ever holds
+// completed passes; the pass schedule depends only on the pass index, so a --time run equals the --spp run
+// of the same sample count. Interruption (SIGINT/SIGTERM) abandons the running pass.
+#pragma once
+
+#include "image_io.h"
+#include "integrator.h"
+#include "light_sampler.h"
+#include "metrics.h"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace bl {
+
+// Options of one render.
+struct render_params {
+  int width = 640, height = 480;
+  int spp = 64;               // target samples per pixel (ignored when time_budget > 0)
+  double time_budget = 0;     // seconds; > 0: render whole passes until this much wall time is spent
+  int max_depth = 5;
+  uint64_t seed = 0;
+  int threads = 0;            // 0: all cores
+  sampler_params sampler;
+  const image_data* reference = nullptr;  // error is measured after every pass when set
+  bool progress = false;      // progress bar on stderr
+};
+
+// One completed pass.
+struct pass_record {
+  int pass = 0;
+  int spp = 0;                // total samples per pixel after this pass
+  double seconds = 0;         // render wall time since the first pass started
+  bool has_error = false;
+  error_metrics error;
+};
+
+// The outcome of a render.
+struct render_result {
+  int width = 0, height = 0;
+  std::vector<double> film;   // per pixel RGB sums over all completed samples
+  int spp = 0;                // samples per pixel in the film
+  int passes = 0;
+  bool interrupted = false;
+  double seconds = 0;         // render wall time (passes and learning, not error computation)
+  double setup_seconds = 0;   // light tree, regions (before the first pass; not in `seconds`)
+  size_t sampler_bytes = 0;   // memory of the sampler's regions, cuts and statistics
+  path_stats stats;
+  std::vector<pass_record> log;
+};
+
+// Samples per pixel of pass `pass` given `done` samples before it (before truncation to the target).
+int pass_size(int pass, int done);
+
+// Renders the scene.
+render_result render(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
+                     const render_params& params);
+// The film's mean image (zero when no sample completed).
+image_data film_image(const render_result& r);
+
+// Installs SIGINT/SIGTERM handlers that request the render to stop; returns the signal seen (0: none).
+void install_interrupt_handlers();
+int interrupt_signal();
+// Clears a pending interrupt request (tests).
+void reset_interrupt();
+
+}  // namespace bl

@@ -1,0 +1,41 @@
+// report: CSV and summary formatting (numbers with enough digits to round-trip).
+#include "report.h"
+
+#include <cstdio>
+
+namespace bl {
+
+std::string pass_log_csv(const std::string& sampler, const std::vector<pass_record>& log) {
+  std::string s = "sampler,pass,spp,seconds,relmse,mse\n";
+  char buf[256];
+  for (const pass_record& p : log) {
+    if (p.has_error)
+      std::snprintf(buf, sizeof buf, "%s,%d,%d,%.6f,%.9g,%.9g\n", sampler.c_str(), p.pass, p.spp, p.seconds,
+                    p.error.relmse, p.error.mse);
+    else
+      std::snprintf(buf, sizeof buf, "%s,%d,%d,%.6f,,\n", sampler.c_str(), p.pass, p.spp, p.seconds);
+    s += buf;
+  }
+  return s;
+}
+
+std::string render_summary(const render_result& r, const std::vector<std::string>& outputs) {
+  const path_stats& st = r.stats;
+  double rays = double(st.camera_rays + st.shadow_rays + st.bounce_rays);
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "%s %d spp in %.2f s (%d passes, %.2f Mrays/s, %.2f M NEE samples/s)",
+                r.interrupted ? "interrupted after" : "rendered", r.spp, r.seconds, r.passes,
+                r.seconds > 0 ? rays / r.seconds * 1e-6 : 0.0,
+                r.seconds > 0 ? double(st.nee_samples) / r.seconds * 1e-6 : 0.0);
+  std::string s = buf;
+  if (st.bad_samples > 0) s += "; " + std::to_string(st.bad_samples) + " non-finite samples discarded";
+  if (r.spp > 0) {
+    s += " -> ";
+    for (size_t i = 0; i < outputs.size(); i++) s += (i ? ", " : "") + outputs[i];
+  } else {
+    s += "; no pass completed, no image written";
+  }
+  return s;
+}
+
+}  // namespace bl

@@ -1,0 +1,75 @@
+// scene: derives the per-triangle columns from a loaded mesh and resolves the camera.
+#include "scene.h"
+
+#include "errors.h"
+
+namespace bl {
+
+scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_params& sun, bool two_sided,
+                       float aspect) {
+  scene_data s;
+  s.mesh = std::move(mesh);
+  const mesh_data& m = s.mesh;
+  int n = triangle_count(m);
+  s.tri_p0.resize(n);
+  s.tri_e1.resize(n);
+  s.tri_e2.resize(n);
+  s.tri_ng.resize(n);
+  s.tri_area.resize(n);
+  for (int t = 0; t < n; t++) {
+    vec3f p0 = m.positions[m.tri_positions[3 * t + 0]];
+    vec3f p1 = m.positions[m.tri_positions[3 * t + 1]];
+    vec3f p2 = m.positions[m.tri_positions[3 * t + 2]];
+    vec3f e1 = p1 - p0, e2 = p2 - p0;
+    vec3f c = cross(e1, e2);
+    float len = length(c);
+    s.tri_p0[t] = p0;
+    s.tri_e1[t] = e1;
+    s.tri_e2[t] = e2;
+    s.tri_ng[t] = len > 0 ? c / len : vec3f{0, 0, 1};
+    s.tri_area[t] = 0.5f * len;
+    s.bounds = merge(merge(merge(s.bounds, p0), p1), p2);
+  }
+  s.material_emissive.resize(m.materials.size());
+  for (size_t i = 0; i < m.materials.size(); i++) {
+    s.material_emissive[i] = !is_black(m.materials[i].ke);
+    s.has_alpha = s.has_alpha || m.materials[i].alpha_texture != invalid_id;
+  }
+  s.scale = is_empty(s.bounds) ? 1.0f : std::max(max_abs_component(s.bounds.lo), max_abs_component(s.bounds.hi));
+  if (!(s.scale > 0)) s.scale = 1;
+  s.camera = camera.automatic ? frame_bounds(s.bounds, camera.fov_y_deg, aspect) : camera;
+  s.sun = sun;
+  s.two_sided_emitters = two_sided;
+  return s;
+}
+
+scene_data build_scene(const scene_desc& desc, float aspect) {
+  return build_scene(load_obj(desc.mesh_path), desc.camera, desc.sun, desc.two_sided_emitters, aspect);
+}
+
+surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f dir) {
+  const mesh_data& m = scene.mesh;
+  surface_point sp;
+  sp.tri = tri;
+  sp.material = m.tri_materials[tri];
+  float b0 = 1.0f - b1 - b2;
+  sp.p = scene.tri_p0[tri] + scene.tri_e1[tri] * b1 + scene.tri_e2[tri] * b2;
+  vec3f ng = scene.tri_ng[tri];
+  sp.front = dot(ng, dir) < 0;
+  sp.ng = sp.front ? ng : -ng;
+  sp.ns = sp.ng;
+  const int* cn = &m.tri_normals[3 * tri];
+  if (cn[0] != invalid_id && cn[1] != invalid_id && cn[2] != invalid_id) {
+    vec3f ns = normalize(m.normals[cn[0]] * b0 + m.normals[cn[1]] * b1 + m.normals[cn[2]] * b2);
+    if (dot(ns, sp.ng) < 0) ns = -ns;
+    if (length_sq(ns) > 0) sp.ns = ns;
+  }
+  const int* ct = &m.tri_texcoords[3 * tri];
+  if (ct[0] != invalid_id && ct[1] != invalid_id && ct[2] != invalid_id) {
+    vec2f t0 = m.texcoords[ct[0]], t1 = m.texcoords[ct[1]], t2 = m.texcoords[ct[2]];
+    sp.uv = {t0.x * b0 + t1.x * b1 + t2.x * b2, t0.y * b0 + t1.y * b1 + t2.y * b2};
+  }
+  return sp;
+}
+
+}  // namespace bl

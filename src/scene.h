@@ -1,0 +1,61 @@
+// scene: the renderable scene — the loaded mesh plus per-triangle columns derived once, camera and sun.
+// Invariants: built once, then read-only (`scene_data`). Triangle t's columns (tri_p0, tri_e1, tri_e2,
+// tri_ng, tri_area) are computed in float from the mesh and are what every intersection and shading
+// computation uses, so results never depend on Embree's ISA-specific arithmetic.
+#pragma once
+
+#include "math.h"
+#include "obj_io.h"
+#include "scene_desc.h"
+
+#include <string>
+#include <vector>
+
+namespace bl {
+
+// Everything the renderer reads about the scene.
+struct scene_data {
+  mesh_data mesh;
+  std::vector<vec3f> tri_p0, tri_e1, tri_e2;  // corner 0 and edges p1-p0, p2-p0
+  std::vector<vec3f> tri_ng;                  // unit geometric normal, cross(e1, e2) direction (CCW front)
+  std::vector<float> tri_area;
+  std::vector<uint8_t> material_emissive;     // per material: Ke non-zero
+  bbox3f bounds;
+  float scale = 1;                            // largest |coordinate| of the bounds (ray offsets)
+  camera_params camera;
+  sun_params sun;
+  bool two_sided_emitters = false;
+  bool has_alpha = false;                     // some material has a map_d cut-out
+};
+
+// Builds the scene of a scene description (loads the OBJ; frames the camera when automatic).
+scene_data build_scene(const scene_desc& desc, float aspect);
+// Builds a scene from an in-memory mesh (tests, generators).
+scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_params& sun, bool two_sided,
+                       float aspect);
+
+// Surface point of a hit: everything shading needs, all in our own float maths.
+struct surface_point {
+  vec3f p;         // position
+  vec3f ng;        // unit geometric normal, facing the incoming ray's origin side
+  vec3f ns;        // unit shading normal, same side as ng
+  vec2f uv;        // texture coordinates (0 when the mesh has none)
+  int tri = invalid_id;
+  int material = invalid_id;
+  bool front = true;  // the ray arrived on the front (CCW) side of the triangle
+};
+
+// Barycentric point (b1, b2) of triangle t seen by a ray with direction `dir`.
+surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f dir);
+
+// Distance to offset a ray origin at p off its surface: scale-aware (relative to the scene's magnitude).
+inline float ray_epsilon(const scene_data& scene, vec3f p) {
+  return 2e-5f * std::max(max_abs_component(p), 0.05f * scene.scale);
+}
+// p moved off its surface along the normal n toward the side of direction d.
+inline vec3f offset_ray_origin(const scene_data& scene, vec3f p, vec3f n, vec3f d) {
+  float eps = ray_epsilon(scene, p);
+  return dot(n, d) >= 0 ? p + n * eps : p - n * eps;
+}
+
+}  // namespace bl

@@ -1,0 +1,210 @@
+// scene_desc: JSON scene files (nlohmann::json, comments allowed) validated key by key.
+#include "scene_desc.h"
+
+#include "errors.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <sstream>
+
+namespace bl {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+// The text of the scene file and helpers to raise errors pointing into it.
+struct desc_context {
+  std::string path;
+  std::string text;
+
+  // 1-based line of the first occurrence of "key" in the file (0 when not found).
+  int line_of(const std::string& key) const {
+    size_t at = text.find("\"" + key + "\"");
+    if (at == std::string::npos) return 0;
+    return 1 + int(std::count(text.begin(), text.begin() + long(at), '\n'));
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
+    throw input_error(path, line_of(key), what);
+  }
+};
+
+// Rejects keys of `obj` that are not in `allowed` (typos must not silently change a render).
+void check_keys(const desc_context& ctx, const json& obj, const std::string& where,
+                std::initializer_list<const char*> allowed) {
+  if (!obj.is_object()) ctx.fail(where, "\"" + where + "\" must be an object");
+  for (auto it = obj.begin(); it != obj.end(); ++it) {
+    bool ok = false;
+    for (const char* a : allowed) ok = ok || it.key() == a;
+    if (!ok) {
+      std::string list;
+      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+      ctx.fail(it.key(), "unknown key \"" + it.key() + "\" in " + where + " (allowed: " + list + ")");
+    }
+  }
+}
+
+// A finite number.
+float get_number(const desc_context& ctx, const json& v, const std::string& key) {
+  if (!v.is_number()) ctx.fail(key, "\"" + key + "\" must be a number");
+  double d = v.get<double>();
+  if (!std::isfinite(d) || std::fabs(d) > 1e30) ctx.fail(key, "\"" + key + "\" must be a finite number");
+  return float(d);
+}
+
+// An integer in [lo, hi].
+int64_t get_integer(const desc_context& ctx, const json& v, const std::string& key, int64_t lo, int64_t hi) {
+  if (!v.is_number_integer()) ctx.fail(key, "\"" + key + "\" must be an integer");
+  if (v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(std::numeric_limits<int64_t>::max()))
+    ctx.fail(key, "\"" + key + "\" is out of range");
+  int64_t i = v.get<int64_t>();
+  if (i < lo || i > hi)
+    ctx.fail(key, "\"" + key + "\" must be between " + std::to_string(lo) + " and " + std::to_string(hi) +
+                      " (got " + std::to_string(i) + ")");
+  return i;
+}
+
+// An array of three finite numbers.
+vec3f get_vec3(const desc_context& ctx, const json& v, const std::string& key) {
+  if (!v.is_array() || v.size() != 3) ctx.fail(key, "\"" + key + "\" must be an array of 3 numbers");
+  return {get_number(ctx, v[0], key), get_number(ctx, v[1], key), get_number(ctx, v[2], key)};
+}
+
+void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
+  check_keys(ctx, j, "camera", {"eye", "target", "up", "fov_y_deg"});
+  bool has_eye = j.contains("eye"), has_target = j.contains("target");
+  if (has_eye != has_target) ctx.fail("camera", "camera needs both \"eye\" and \"target\" (or neither)");
+  cam.automatic = !has_eye;
+  if (has_eye) cam.eye = get_vec3(ctx, j["eye"], "eye");
+  if (has_target) cam.target = get_vec3(ctx, j["target"], "target");
+  if (j.contains("up")) cam.up = get_vec3(ctx, j["up"], "up");
+  if (j.contains("fov_y_deg")) cam.fov_y_deg = get_number(ctx, j["fov_y_deg"], "fov_y_deg");
+  if (!(cam.fov_y_deg > 0 && cam.fov_y_deg < 179))
+    ctx.fail("fov_y_deg", "\"fov_y_deg\" must be in (0, 179) degrees");
+  vec3f dir = cam.target - cam.eye;
+  if (has_eye && !(length(dir) > 0)) ctx.fail("target", "camera \"eye\" and \"target\" must differ");
+  if (!(length(cam.up) > 0)) ctx.fail("up", "camera \"up\" must be a non-zero vector");
+  if (has_eye && !(length(cross(normalize(dir), normalize(cam.up))) > 1e-6f))
+    ctx.fail("up", "camera \"up\" must not be parallel to the viewing direction");
+}
+
+void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
+  check_keys(ctx, j, "sun", {"direction", "irradiance", "angular_diameter_deg"});
+  if (!j.contains("direction") || !j.contains("irradiance"))
+    ctx.fail("sun", "\"sun\" needs \"direction\" and \"irradiance\"");
+  sun.enabled = true;
+  vec3f d = get_vec3(ctx, j["direction"], "direction");
+  if (!(length(d) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
+  sun.direction = normalize(d);
+  sun.irradiance = get_vec3(ctx, j["irradiance"], "irradiance");
+  if (sun.irradiance.x < 0 || sun.irradiance.y < 0 || sun.irradiance.z < 0)
+    ctx.fail("irradiance", "sun \"irradiance\" must not be negative");
+  if (j.contains("angular_diameter_deg"))
+    sun.angular_diameter_deg = get_number(ctx, j["angular_diameter_deg"], "angular_diameter_deg");
+  if (!(sun.angular_diameter_deg > 0 && sun.angular_diameter_deg < 90))
+    ctx.fail("angular_diameter_deg", "sun \"angular_diameter_deg\" must be in (0, 90)");
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+}  // namespace
+
+// Largest image side and pixel count a scene may ask for (the CLI applies the same limits).
+constexpr int64_t max_image_side = 65536;
+constexpr int64_t max_image_pixels = int64_t(1) << 28;
+
+scene_desc load_scene_desc(const std::string& path) {
+  scene_desc desc;
+  desc.path = path;
+  std::string ext = lower_extension(path);
+  if (ext != ".json" && ext != ".obj")
+    throw input_error(path, "unknown scene type \"" + ext + "\" (expected a .json scene file or a .obj mesh)");
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw input_error(path, "is a directory, not a scene file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw input_error(path, std::string("cannot open: ") + std::strerror(errno));
+  if (ext == ".obj") {
+    desc.mesh_path = path;
+    return desc;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  desc_context ctx{path, ss.str()};
+
+  json root;
+  try {
+    root = json::parse(ctx.text, nullptr, true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    // e.byte is the 1-based offset of the offending byte; turn it into a line number.
+    size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, ctx.text.size());
+    int line = 1 + int(std::count(ctx.text.begin(), ctx.text.begin() + long(at), '\n'));
+    std::string msg = e.what();
+    size_t cut = msg.find("syntax error");
+    throw input_error(path, line, "malformed JSON: " + (cut == std::string::npos ? msg : msg.substr(cut)));
+  }
+  check_keys(ctx, root, "the scene file", {"mesh", "camera", "image", "render", "sun", "two_sided_emitters"});
+  if (!root.contains("mesh")) throw input_error(path, "missing required key \"mesh\"");
+  if (!root["mesh"].is_string() || root["mesh"].get<std::string>().empty())
+    ctx.fail("mesh", "\"mesh\" must be a non-empty string (a path to an .obj file)");
+  fs::path mesh = root["mesh"].get<std::string>();
+  desc.mesh_path = mesh.is_absolute() ? mesh.string() : (fs::path(path).parent_path() / mesh).string();
+
+  if (root.contains("camera")) parse_camera(ctx, root["camera"], desc.camera);
+  if (root.contains("image")) {
+    const json& im = root["image"];
+    check_keys(ctx, im, "image", {"width", "height"});
+    if (im.contains("width")) desc.width = int(get_integer(ctx, im["width"], "width", 1, max_image_side));
+    if (im.contains("height")) desc.height = int(get_integer(ctx, im["height"], "height", 1, max_image_side));
+    if (int64_t(desc.width) * desc.height > max_image_pixels)
+      ctx.fail("image", "image of " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
+                            " pixels is too large (at most 2^28 pixels)");
+  }
+  if (root.contains("render")) {
+    const json& r = root["render"];
+    check_keys(ctx, r, "render", {"spp", "max_depth", "seed"});
+    if (r.contains("spp")) desc.spp = int(get_integer(ctx, r["spp"], "spp", 1, std::numeric_limits<int>::max()));
+    if (r.contains("max_depth")) desc.max_depth = int(get_integer(ctx, r["max_depth"], "max_depth", 1, 1000));
+    if (r.contains("seed")) {
+      if (r["seed"].is_number_unsigned()) desc.seed = r["seed"].get<uint64_t>();
+      else desc.seed = uint64_t(get_integer(ctx, r["seed"], "seed", 0, std::numeric_limits<int64_t>::max()));
+    }
+  }
+  if (root.contains("sun")) parse_sun(ctx, root["sun"], desc.sun);
+  if (root.contains("two_sided_emitters")) {
+    if (!root["two_sided_emitters"].is_boolean())
+      ctx.fail("two_sided_emitters", "\"two_sided_emitters\" must be true or false");
+    desc.two_sided_emitters = root["two_sided_emitters"].get<bool>();
+  }
+  return desc;
+}
+
+camera_params frame_bounds(const bbox3f& bounds, float fov_y_deg, float aspect) {
+  camera_params cam;
+  cam.automatic = true;
+  cam.fov_y_deg = fov_y_deg;
+  vec3f c = center(bounds);
+  float radius = 0.5f * diagonal(bounds);
+  if (!(radius > 0)) radius = 1;
+  // The bounding sphere fits inside the narrower of the two fields of view.
+  float half_y = 0.5f * fov_y_deg * pi_f / 180.0f;
+  float half_x = std::atan(std::tan(half_y) * aspect);
+  float dist = radius / std::sin(std::min(half_y, half_x));
+  cam.target = c;
+  cam.eye = c + vec3f{0, 0, dist};
+  cam.up = {0, 1, 0};
+  return cam;
+}
+
+}  // namespace bl

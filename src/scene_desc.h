@@ -1,0 +1,47 @@
+// scene_desc: the scene file of SPEC.md section 3 (JSON) or a bare OBJ, parsed into plain parameters.
+// Invariants: every value is validated (finite, in range) and every unknown key is an error, so a typo
+// can never silently change a render; defaults are those of a bare OBJ. Paths are resolved to be usable
+// from the current directory.
+#pragma once
+
+#include "math.h"
+
+#include <cstdint>
+#include <string>
+
+namespace bl {
+
+// Pinhole camera placement; `automatic` means "frame the mesh bounds from +z" (no camera in the file).
+struct camera_params {
+  bool automatic = true;
+  vec3f eye = {0, 0, 1}, target = {0, 0, 0}, up = {0, 1, 0};
+  float fov_y_deg = 45;
+};
+
+// A distant disk light. direction points from the scene toward the sun (unit length after parsing).
+struct sun_params {
+  bool enabled = false;
+  vec3f direction = {0, 1, 0};
+  vec3f irradiance = {0, 0, 0};
+  float angular_diameter_deg = 0.53f;
+};
+
+// Everything a scene file says.
+struct scene_desc {
+  std::string path;       // the scene file itself (for messages)
+  std::string mesh_path;  // OBJ, resolved relative to the scene file
+  camera_params camera;
+  int width = 640, height = 480;
+  int spp = 64, max_depth = 5;
+  uint64_t seed = 0;
+  sun_params sun;
+  bool two_sided_emitters = false;
+};
+
+// Reads a .json scene file or wraps a bare .obj; throws input_error naming the file (and line) on problems.
+scene_desc load_scene_desc(const std::string& path);
+
+// The camera of a bare OBJ: looks at the centre of `bounds` from the +z side, whole box in view.
+camera_params frame_bounds(const bbox3f& bounds, float fov_y_deg, float aspect);
+
+}  // namespace bl

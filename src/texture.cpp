@@ -1,0 +1,175 @@
+// texture: decodes images with stb_image (implementation in libstb) into linear float texels, and filters them.
+// Invariants: only the PNG, JPEG, BMP and TGA decoders are ever reached (other formats are refused by their
+// magic bytes first: they are the least hardened parts of stb_image); the file is read once into memory; the
+// decoded orientation is pinned (top row first) whatever stb's global flip flag says.
+#include "texture.h"
+
+#include "errors.h"
+#include "file_io.h"
+
+#include <stb_image.h>
+
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <memory>
+
+namespace bl {
+
+// sRGB EOTF of a code value c in [0, 1], in float maths (powf is bit-identical across x86-64 CPUs).
+static float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
+
+float srgb8_to_linear(unsigned char v) { return srgb_to_linear(float(v) / 255.0f); }
+
+// Reads a regular file into memory (a FIFO would block forever); throws input_error with the reason.
+static std::string read_image_file(const std::string& path) {
+  std::error_code ec;
+  auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw input_error(path, "cannot open image: no such file");
+  if (!std::filesystem::is_regular_file(status)) throw input_error(path, "cannot open image: not a regular file");
+  return read_file(path);
+}
+
+// Name of an image format stb_image could decode but we refuse, from the file's first bytes ("" if none).
+static const char* refused_format(const std::string& b) {
+  auto starts = [&](const char* magic) { return b.compare(0, std::strlen(magic), magic) == 0; };
+  if (starts("#?RADIANCE") || starts("#?RGBE")) return "HDR (Radiance)";
+  if (starts("GIF8")) return "GIF";
+  if (starts("8BPS")) return "PSD";
+  if (starts("\x53\x80\xF6\x34")) return "PIC";
+  if (b.size() >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '7') return "PNM";
+  return "";
+}
+
+// True when the first bytes are those of a PNG, JPEG or BMP file, or the name ends in .tga (TGA has no magic).
+static bool accepted_format(const std::string& b, const std::string& path) {
+  auto starts = [&](const char* magic, size_t n) { return b.size() >= n && std::memcmp(b.data(), magic, n) == 0; };
+  if (starts("\x89PNG\r\n\x1a\n", 8) || starts("\xFF\xD8\xFF", 3) || starts("BM", 2)) return true;
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower((unsigned char)c));
+  return ext == ".tga";
+}
+
+// stb_image's reason for the last failure (never null).
+static std::string stb_reason() {
+  const char* r = stbi_failure_reason();
+  return r ? r : "unknown error";
+}
+
+// Frees stb_image's pixel buffers.
+struct stbi_deleter {
+  void operator()(void* p) const { stbi_image_free(p); }
+};
+
+// Fills rgb and alpha of tex from n-channel pixels (8- or 16-bit); colour goes through to_linear[value].
+template <typename T>
+static void fill_texels(texture_data& tex, const T* px, int n, const std::vector<float>& to_linear) {
+  const float inv_max = 1.0f / float(std::numeric_limits<T>::max());
+  size_t count = size_t(tex.width) * size_t(tex.height);
+  tex.rgb.resize(count);
+  tex.alpha.resize(count);
+  for (size_t i = 0; i < count; i++) {
+    const T* p = px + i * size_t(n);
+    if (n >= 3) {
+      tex.rgb[i] = {to_linear[p[0]], to_linear[p[1]], to_linear[p[2]]};
+    } else {
+      float g = to_linear[p[0]];
+      tex.rgb[i] = {g, g, g};
+    }
+    // Alpha channel when there is one (2 or 4 channels), else the first channel (a greyscale mask).
+    T a = (n == 2 || n == 4) ? p[n - 1] : p[0];
+    tex.alpha[i] = float(a) * inv_max;
+  }
+}
+
+texture_data load_texture(const std::string& path) {
+  std::string bytes = read_image_file(path);
+  if (bytes.empty()) throw input_error(path, "cannot decode image: empty file");
+  if (bytes.size() > size_t(std::numeric_limits<int>::max())) throw input_error(path, "image file too large");
+  if (const char* fmt = refused_format(bytes); *fmt)
+    throw input_error(path,
+                      std::string("unsupported image format ") + fmt + " (use 8- or 16-bit PNG, JPEG, BMP or TGA)");
+  if (!accepted_format(bytes, path)) throw input_error(path, "cannot decode image: not a PNG, JPEG, BMP or TGA file");
+  auto data = reinterpret_cast<const stbi_uc*>(bytes.data());
+  int len = int(bytes.size());
+  int w = 0, h = 0, n = 0;
+  if (!stbi_info_from_memory(data, len, &w, &h, &n)) throw input_error(path, "cannot decode image: " + stb_reason());
+  if (w <= 0 || h <= 0 || n < 1 || n > 4) throw input_error(path, "cannot decode image: bad header");
+  if ((long long)w * h > max_texture_texels)
+    throw input_error(path, "image too large (" + std::to_string(w) + "x" + std::to_string(h) + " texels)");
+
+  texture_data tex;
+  tex.path = path;
+  stbi_set_flip_vertically_on_load_thread(0);
+  int dw = 0, dh = 0, dn = 0;
+  if (stbi_is_16_bit_from_memory(data, len)) {
+    std::unique_ptr<stbi_us, stbi_deleter> px(stbi_load_16_from_memory(data, len, &dw, &dh, &dn, 0));
+    if (!px) throw input_error(path, "cannot decode image: " + stb_reason());
+    if (dw != w || dh != h || dn < 1 || dn > 4) throw input_error(path, "cannot decode image: inconsistent header");
+    std::vector<float> table(65536);
+    for (int v = 0; v < 65536; v++) table[v] = srgb_to_linear(float(v) / 65535.0f);
+    tex.width = dw;
+    tex.height = dh;
+    fill_texels(tex, px.get(), dn, table);
+  } else {
+    std::unique_ptr<stbi_uc, stbi_deleter> px(stbi_load_from_memory(data, len, &dw, &dh, &dn, 0));
+    if (!px) throw input_error(path, "cannot decode image: " + stb_reason());
+    if (dw != w || dh != h || dn < 1 || dn > 4) throw input_error(path, "cannot decode image: inconsistent header");
+    std::vector<float> table(256);
+    for (int v = 0; v < 256; v++) table[v] = srgb8_to_linear((unsigned char)v);
+    tex.width = dw;
+    tex.height = dh;
+    fill_texels(tex, px.get(), dn, table);
+  }
+  return tex;
+}
+
+// Fractional part in [0, 1); NaN, infinities (and the rare round-up to 1) map to 0.
+static float wrap01(float x) {
+  float f = x - floorf(x);
+  return (f >= 0.0f && f < 1.0f) ? f : 0.0f;
+}
+
+// Bilinear footprint along one axis of n texels: lower texel i0, upper i1 (wrapped) and the weight of i1.
+// Texel k covers [k, k+1) / n, its centre at (k + 0.5) / n.
+static void axis_footprint(float f, int n, int& i0, int& i1, float& w1) {
+  float s = f * float(n) - 0.5f;  // in [-0.5, n - 0.5)
+  float fl = floorf(s);
+  w1 = s - fl;
+  int k = int(fl);  // in [-1, n - 1]
+  if (k < 0) k = n - 1;
+  if (k > n - 1) k = n - 1;
+  i0 = k;
+  i1 = k + 1 < n ? k + 1 : 0;
+}
+
+// Nearest texel index along one axis of n texels for f in [0, 1).
+static int axis_nearest(float f, int n) {
+  int k = int(f * float(n));
+  return k < 0 ? 0 : (k > n - 1 ? n - 1 : k);
+}
+
+vec3f eval_texture_rgb(const texture_data& tex, vec2f uv) {
+  if (tex.width <= 0 || tex.height <= 0 || tex.rgb.size() != size_t(tex.width) * size_t(tex.height)) return {0, 0, 0};
+  int x0, x1, b0, b1;
+  float wx, wb;
+  axis_footprint(wrap01(uv.x), tex.width, x0, x1, wx);
+  // v counts rows from the bottom: bottom-based row b is image row height - 1 - b.
+  axis_footprint(wrap01(uv.y), tex.height, b0, b1, wb);
+  int y0 = tex.height - 1 - b0, y1 = tex.height - 1 - b1;
+  auto at = [&](int x, int y) { return tex.rgb[size_t(y) * size_t(tex.width) + size_t(x)]; };
+  vec3f lo = at(x0, y0) * (1.0f - wx) + at(x1, y0) * wx;
+  vec3f hi = at(x0, y1) * (1.0f - wx) + at(x1, y1) * wx;
+  return lo * (1.0f - wb) + hi * wb;
+}
+
+float eval_texture_alpha(const texture_data& tex, vec2f uv) {
+  if (tex.width <= 0 || tex.height <= 0 || tex.alpha.size() != size_t(tex.width) * size_t(tex.height)) return 1.0f;
+  int x = axis_nearest(wrap01(uv.x), tex.width);
+  int y = tex.height - 1 - axis_nearest(wrap01(uv.y), tex.height);
+  return tex.alpha[size_t(y) * size_t(tex.width) + size_t(x)];
+}
+
+}  // namespace bl

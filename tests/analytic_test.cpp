@@ -1,0 +1,125 @@
+// Analytic scenes with closed-form radiance, rendered through the whole pipeline (scene, Embree, lights,
+// samplers, integrator, pass loop) and checked statistically: every pixel is an independent estimate, and
+// the mean over pixels must lie within 4.4 standard errors of the exact value (two-sided confidence 99.999%),
+// while the standard error itself must be small enough (< 1% of the value) for the test to be decisive.
+#include "bvh.h"
+#include "lights.h"
+#include "render.h"
+#include "scene.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+constexpr double z_crit = 4.4;
+
+// Renders an in-memory scene and returns the per-pixel luminance-free red channel estimates.
+std::vector<double> render_pixels(mesh_data mesh, const camera_params& cam, const sun_params& sun, bool two_sided,
+                                  sampler_kind kind, int max_depth, int spp, int size = 8, uint64_t seed = 1) {
+  scene_data scene = build_scene(std::move(mesh), cam, sun, two_sided, 1.0f);
+  bvh_data bvh = build_bvh(scene);
+  light_data lights = build_lights(scene);
+  render_params p;
+  p.width = p.height = size;
+  p.spp = spp;
+  p.max_depth = max_depth;
+  p.seed = seed;
+  p.threads = 2;
+  p.sampler.kind = kind;
+  render_result r = render(scene, bvh, lights, p);
+  image_data img = film_image(r);
+  std::vector<double> red;
+  for (int i = 0; i < size * size; i++) red.push_back(img.pixels[3 * size_t(i)]);
+  return red;
+}
+
+// Checks the pixel estimates against the exact value (see the file header for the criterion).
+void check_estimate(const std::vector<double>& px, double exact) {
+  mean_se m = mean_and_se(px);
+  INFO("mean " << m.mean << " +- " << m.se << " exact " << exact);
+  CHECK(m.se < 0.01 * exact);
+  CHECK(std::fabs(m.mean - exact) < z_crit * m.se);
+}
+
+// A camera at height `h` looking straight down at the origin with a narrow field of view.
+camera_params looking_down(float h) {
+  camera_params c;
+  c.automatic = false;
+  c.eye = {0, h, 0};
+  c.target = {0, 0, 0};
+  c.up = {0, 0, -1};
+  c.fov_y_deg = 0.5f;
+  return c;
+}
+
+const sampler_kind kinds[] = {sampler_kind::uniform, sampler_kind::power};
+
+}  // namespace
+
+TEST_CASE("a point under a large emitting square receives the closed form irradiance", "[analytic]") {
+  // Square of side 2a at height h, radiance Le, facing down onto a Lambertian floor of albedo rho.
+  // E = 4 Le A / sqrt(1 + A^2) atan(A / sqrt(1 + A^2)), A = a / h; outgoing radiance rho E / pi.
+  const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
+  for (sampler_kind kind : kinds)
+    for (int depth : {1, 2}) {
+      mesh_builder b;
+      int floor = b.add_material({rho, rho, rho});
+      int lamp = b.add_material({0, 0, 0}, {le, le, le});
+      int dim = b.add_material({0, 0, 0}, {0.1f, 0.1f, 0.1f});
+      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
+      b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);  // normal -y: faces the floor
+      b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, dim);       // faces up: never lights the floor
+      double A = a / h, s = A / std::sqrt(1 + A * A);
+      double exact = rho / M_PI * 4 * le * s * std::atan(s);
+      INFO("sampler " << sampler_name(kind) << " depth " << depth);
+      check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, depth, 1024), exact);
+    }
+}
+
+TEST_CASE("a furnace box of emitting grey walls sums its bounces", "[analytic]") {
+  // Closed box, every wall emits Le (two-sided) with albedo rho: radiance Le * sum_{k=0..D} rho^k.
+  const float le = 1.0f, rho = 0.5f;
+  for (sampler_kind kind : kinds)
+    for (int depth : {1, 3, 5}) {
+      mesh_builder b;
+      int wall = b.add_material({rho, rho, rho}, {le, le, le});
+      b.add_box({-1, -1, -1}, {1, 1, 1}, wall);
+      camera_params cam;
+      cam.automatic = false;
+      cam.eye = {0, 0, 0};
+      cam.target = {0.3f, 0.2f, 1};
+      cam.fov_y_deg = 60;
+      double exact = 0;
+      for (int k = 0; k <= depth; k++) exact += le * std::pow(rho, k);
+      INFO("sampler " << sampler_name(kind) << " depth " << depth);
+      check_estimate(render_pixels(b.mesh, cam, {}, true, kind, depth, 128), exact);
+    }
+}
+
+TEST_CASE("the sun lights a floor with its irradiance times the cosine", "[analytic]") {
+  // A uniform disk's cosine-weighted solid angle is cos(theta_s) pi sin^2(theta_max): E = E_sun cos(theta_s).
+  const float rho = 0.6f, e_sun = 3.0f;
+  vec3f dir = normalize(vec3f{0.3f, 1.0f, 0.2f});
+  for (sampler_kind kind : kinds)
+    for (int depth : {1, 2}) {
+      mesh_builder b;
+      int floor = b.add_material({rho, rho, rho});
+      // A lamp facing up (no contribution) with about the sun's power, so that light selection matters and
+      // the wasted samples are frequent enough for the pixel variance to show them.
+      int lamp = b.add_material({0, 0, 0}, {3000, 3000, 3000});
+      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
+      b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, lamp);
+      sun_params sun;
+      sun.enabled = true;
+      sun.direction = dir;
+      sun.irradiance = {e_sun, e_sun, e_sun};
+      sun.angular_diameter_deg = 0.53f;
+      double exact = rho / M_PI * e_sun * dir.y;
+      INFO("sampler " << sampler_name(kind) << " depth " << depth);
+      check_estimate(render_pixels(b.mesh, looking_down(1), sun, false, kind, depth, 512), exact);
+    }
+}

@@ -1,0 +1,190 @@
+// Tests of the command line as users drive it: exit statuses (SPEC.md section 4), messages that name the
+// problem (file and line), no output file left behind by a failure, the diff command, and the per-pass log.
+#include "image_io.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+// A tiny valid scene: a floor and a one-sided lamp, plus its scene file.
+struct tiny_scene {
+  temp_dir dir;
+  std::string json;
+  tiny_scene(const std::string& extra_json = "") {
+    write_text(dir / "box.obj",
+               "mtllib box.mtl\n"
+               "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
+               "v -0.2 1 -0.2\nv 0.2 1 -0.2\nv 0.2 1 0.2\nv -0.2 1 0.2\n"
+               "usemtl floor\nf 1 4 3 2\n"
+               "usemtl lamp\nf 5 6 7 8\n");
+    write_text(dir / "box.mtl", "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
+    json = dir / "scene.json";
+    write_text(json, "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], \"target\": [0, 0, 0]},"
+                     " \"image\": {\"width\": 16, \"height\": 12}, \"render\": {\"spp\": 2, \"max_depth\": 2}" +
+                         extra_json + "}");
+  }
+};
+
+bool exists(const std::string& p) { return std::filesystem::exists(p); }
+
+}  // namespace
+
+TEST_CASE("a render writes every requested output and a per pass log", "[cli]") {
+  tiny_scene s;
+  auto r = run_bayeslight("render " + s.json + " --sampler power -o " + (s.dir / "a.exr") + " -o " +
+                          (s.dir / "a.pfm") + " -o " + (s.dir / "a.png") + " --log " + (s.dir / "log.csv") +
+                          " --quiet");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(exists(s.dir / "a.exr"));
+  CHECK(exists(s.dir / "a.png"));
+  image_data a = read_image(s.dir / "a.exr"), b = read_image(s.dir / "a.pfm");
+  CHECK(a.width == 16);
+  CHECK(a.height == 12);
+  CHECK(a.pixels == b.pixels);
+  std::ifstream log(s.dir / "log.csv");
+  std::string header, row;
+  std::getline(log, header);
+  CHECK(header == "sampler,pass,spp,seconds,relmse,mse");
+  int rows = 0;
+  while (std::getline(log, row)) {
+    rows++;
+    CHECK(row.rfind("power,", 0) == 0);
+    CHECK(row.size() >= 2);
+    CHECK(row.substr(row.size() - 2) == ",,");  // no reference: empty error columns
+  }
+  CHECK(rows == 2);
+  // No temporary files left next to the outputs.
+  for (auto& e : std::filesystem::directory_iterator(s.dir.path))
+    CHECK(e.path().filename().string().find(".tmp") == std::string::npos);
+}
+
+TEST_CASE("the log carries error against a reference and diff reports it", "[cli]") {
+  tiny_scene s;
+  REQUIRE(run_bayeslight("render " + s.json + " --sampler uniform --spp 16 -o " + (s.dir / "ref.exr") + " --quiet")
+              .status == 0);
+  auto r = run_bayeslight("render " + s.json + " --sampler power --spp 3 -o " + (s.dir / "x.exr") +
+                          " --reference " + (s.dir / "ref.exr") + " --log " + (s.dir / "log.csv") + " --quiet");
+  REQUIRE(r.status == 0);
+  std::ifstream log(s.dir / "log.csv");
+  std::string line, last;
+  while (std::getline(log, line)) last = line;
+  auto d = run_bayeslight("diff " + (s.dir / "x.exr") + " " + (s.dir / "ref.exr"));
+  REQUIRE(d.status == 0);
+  CHECK(d.output.find("relmse=") != std::string::npos);
+  CHECK(d.output.find("identical") == std::string::npos);
+  // The log's last relmse is the diff's relmse (same formula, same images).
+  std::string relmse_log = last.substr(0, last.rfind(','));
+  relmse_log = relmse_log.substr(relmse_log.rfind(',') + 1);
+  std::string relmse_diff = d.output.substr(7, d.output.find(' ') - 7);
+  CHECK(std::stod(relmse_log) == Approx(std::stod(relmse_diff)).epsilon(1e-6));
+  auto same = run_bayeslight("diff " + (s.dir / "x.exr") + " " + (s.dir / "x.exr"));
+  CHECK(same.output.find("identical") != std::string::npos);
+}
+
+TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
+  tiny_scene s;
+  struct bad_case {
+    std::string args, expect;
+  };
+  std::vector<bad_case> cases = {
+      {"", ""},
+      {"render", "SCENE"},
+      {"render " + s.json + " --sampler nosuch", "uniform | power"},
+      {"render " + s.json + " --spp 0", "--spp"},
+      {"render " + s.json + " --spp -3", "--spp"},
+      {"render " + s.json + " --spp abc", "--spp"},
+      {"render " + s.json + " --spp 4 --time 1", "--time"},
+      {"render " + s.json + " --threads 0", "--threads"},
+      {"render " + s.json + " --max-depth 0", "--max-depth"},
+      {"render " + s.json + " --width 0", "--width"},
+      {"render " + s.json + " --width 1000000 --height 1000000", "--width"},
+      {"render " + s.json + " --width 60000 --height 60000", "too large"},
+      {"render " + s.json + " -o " + (s.dir / "out.jpg"), "unknown image format"},
+      {"render " + s.json + " --bogus", "--bogus"},
+      {"frobnicate", "frobnicate"},
+  };
+  for (const auto& c : cases) {
+    auto r = run_bayeslight(c.args);
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(c.expect) != std::string::npos);
+  }
+  CHECK(!exists(s.dir / "out.jpg"));
+}
+
+TEST_CASE("bad input files exit 3 name the file and line and leave no output", "[cli]") {
+  tiny_scene s;
+  struct bad_case {
+    std::string name, text, expect;
+  };
+  std::vector<bad_case> cases = {
+      {"missing.json", "", "missing.json"},
+      {"syntax.json", "{\"mesh\": \"box.obj\",\n \"image\": {\"width\": 4,}\n}", "syntax.json:2"},
+      {"unknown.json", "{\"mesh\": \"box.obj\",\n \"imgae\": {}}", "unknown.json:2: unknown key \"imgae\""},
+      {"nested.json", "{\"mesh\": \"box.obj\", \"render\": {\"sp\": 4}}", "unknown key \"sp\""},
+      {"nomesh.json", "{\"image\": {\"width\": 4}}", "\"mesh\""},
+      {"negative.json", "{\"mesh\": \"box.obj\", \"image\": {\"width\": -4}}", "\"width\""},
+      {"zero.json", "{\"mesh\": \"box.obj\", \"image\": {\"width\": 0, \"height\": 4}}", "\"width\""},
+      {"nan.json", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [NaN, 0, 0], \"target\": [0,0,0]}}", "nan.json"},
+      {"badsun.json", "{\"mesh\": \"box.obj\", \"sun\": {\"direction\": [0,0,0], \"irradiance\": [1,1,1]}}",
+       "direction"},
+      {"negsun.json", "{\"mesh\": \"box.obj\", \"sun\": {\"direction\": [0,1,0], \"irradiance\": [-1,1,1]}}",
+       "irradiance"},
+      {"fov.json", "{\"mesh\": \"box.obj\", \"camera\": {\"fov_y_deg\": 0}}", "fov_y_deg"},
+      {"type.json", "{\"mesh\": \"box.obj\", \"render\": {\"spp\": \"many\"}}", "\"spp\""},
+      {"nofile.json", "{\"mesh\": \"nothere.obj\"}", "nothere.obj"},
+      {"badobj.json", "{\"mesh\": \"bad.obj\"}", "bad.obj:2"},
+      {"scene.txt", "{}", "scene.txt"},
+  };
+  write_text(s.dir / "bad.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n");
+  for (const auto& c : cases) {
+    if (!c.text.empty()) write_text(s.dir / c.name, c.text);
+    auto r = run_bayeslight("render " + (s.dir / c.name) + " --quiet -o " + (s.dir / "out.exr"));
+    INFO(c.name << "\n" << r.output);
+    CHECK(r.status == 3);
+    CHECK(r.output.find(c.expect) != std::string::npos);
+    CHECK(!exists(s.dir / "out.exr"));
+  }
+  // A reference of the wrong size, or not an image.
+  write_text(s.dir / "garbage.exr", "not an exr");
+  auto r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "out.exr") + " --reference " +
+                          (s.dir / "garbage.exr"));
+  CHECK(r.status == 3);
+  CHECK(r.output.find("garbage.exr") != std::string::npos);
+  CHECK(!exists(s.dir / "out.exr"));
+  auto d = run_bayeslight("diff " + (s.dir / "garbage.exr") + " " + (s.dir / "garbage.exr"));
+  CHECK(d.status == 3);
+}
+
+TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
+  tiny_scene s;
+  auto r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "no/such/dir/out.exr"));
+  CHECK(r.status == 1);
+  CHECK(r.output.find("no/such/dir") != std::string::npos);
+}
+
+TEST_CASE("a bare OBJ renders with the default framing", "[cli]") {
+  tiny_scene s;
+  auto r = run_bayeslight("render " + (s.dir / "box.obj") + " --spp 1 --width 8 --height 6 --quiet -o " +
+                          (s.dir / "o.pfm"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  image_data img = read_image(s.dir / "o.pfm");
+  CHECK(img.width == 8);
+  double sum = 0;
+  for (float v : img.pixels) sum += v;
+  CHECK(sum > 0);  // the lit floor is in view
+}
+
+TEST_CASE("help lists the samplers and options", "[cli]") {
+  auto r = run_bayeslight("render --help");
+  CHECK(r.status == 0);
+  for (const char* s : {"--sampler", "--spp", "--time", "--max-depth", "--threads", "--seed", "--reference", "--log",
+                        "--quiet", "bayes"})
+    CHECK(r.output.find(s) != std::string::npos);
+}

@@ -1,0 +1,388 @@
+// Tests of the OBJ loader: triangulation (winding, concave polygons), index forms, materials and textures,
+// degenerate triangles, compaction, and that every malformed or hostile input is an input_error naming the
+// file and line. Each test writes its OBJ/MTL/PNG files into a fresh mkdtemp directory.
+#include "errors.h"
+#include "obj_io.h"
+
+#include <catch2/catch.hpp>
+#include <stb_image_write.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+using namespace bl;
+
+namespace {
+
+// A fresh temporary directory, removed with everything in it at the end of the test.
+struct temp_dir {
+  std::string path;
+  temp_dir() {
+    char tmpl[] = "/tmp/bl_obj_test_XXXXXX";
+    REQUIRE(mkdtemp(tmpl) != nullptr);
+    path = tmpl;
+  }
+  ~temp_dir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  // Writes a file (text or bytes) into the directory and returns its path.
+  std::string write(const std::string& name, const std::string& content) const {
+    std::string p = path + "/" + name;
+    std::ofstream(p, std::ios::binary) << content;
+    return p;
+  }
+};
+
+// The message of the input_error that loading path throws ("" when it loads); other exceptions escape.
+std::string load_error(const std::string& path) {
+  try {
+    load_obj(path);
+  } catch (const input_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Corner c of triangle t.
+vec3f corner(const mesh_data& m, int t, int c) { return m.positions[size_t(m.tri_positions[size_t(3 * t + c)])]; }
+
+// Unnormalised geometric normal (twice the area vector) of triangle t.
+vec3f area_vector(const mesh_data& m, int t) {
+  return cross(corner(m, t, 1) - corner(m, t, 0), corner(m, t, 2) - corner(m, t, 0));
+}
+
+// Checks the invariants every loaded mesh keeps.
+void check_invariants(const mesh_data& m) {
+  int n = triangle_count(m);
+  REQUIRE(m.tri_positions.size() == size_t(3 * n));
+  REQUIRE(m.tri_normals.size() == size_t(3 * n));
+  REQUIRE(m.tri_texcoords.size() == size_t(3 * n));
+  for (int i = 0; i < 3 * n; i++) {
+    REQUIRE(m.tri_positions[size_t(i)] >= 0);
+    REQUIRE(m.tri_positions[size_t(i)] < int(m.positions.size()));
+    REQUIRE(m.tri_normals[size_t(i)] < int(m.normals.size()));
+    REQUIRE(m.tri_texcoords[size_t(i)] < int(m.texcoords.size()));
+  }
+  for (int t = 0; t < n; t++) {
+    REQUIRE(m.tri_materials[size_t(t)] >= 0);
+    REQUIRE(m.tri_materials[size_t(t)] < int(m.materials.size()));
+    REQUIRE(length_sq(area_vector(m, t)) > 0);
+  }
+  for (vec3f nn : m.normals) REQUIRE(std::fabs(length(nn) - 1.0f) < 1e-6f);
+}
+
+// A 2x1 RGBA PNG: texel 0 sRGB 128 grey with alpha 255, texel 1 white with alpha 0.
+std::string write_png(const temp_dir& dir, const std::string& name) {
+  std::string p = dir.path + "/" + name;
+  unsigned char px[8] = {128, 128, 128, 255, 255, 255, 255, 0};
+  REQUIRE(stbi_write_png(p.c_str(), 2, 1, 4, px, 8) != 0);
+  return p;
+}
+
+const char* square_vertices = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+
+}  // namespace
+
+TEST_CASE("a quad and a pentagon are triangulated with their winding kept", "[obj]") {
+  temp_dir dir;
+  auto obj = dir.write("poly.obj", std::string(square_vertices) +
+                                       "v 2 0 0\nv 3 0 0\nv 3.5 1 0\nv 2.5 2 0\nv 1.5 1 0\n"
+                                       "f 1 2 3 4\nf 5 6 7 8 9\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  REQUIRE(triangle_count(m) == 5);
+  float quad_area = 0, pentagon_area = 0;
+  for (int t = 0; t < 5; t++) {
+    vec3f a = area_vector(m, t);
+    CHECK(a.z > 0);  // counter-clockwise seen from +z, as written
+    (t < 2 ? quad_area : pentagon_area) += 0.5f * a.z;
+  }
+  CHECK(quad_area == Approx(1.0f));
+  CHECK(pentagon_area == Approx(2.5f));  // shoelace area of the pentagon
+  CHECK(m.dropped_degenerate == 0);
+}
+
+TEST_CASE("a concave polygon in a tilted plane is triangulated inside its outline", "[obj]") {
+  temp_dir dir;
+  // An L of area 3 in the plane x = z, wound so that its normal points along (1, 0, -1) / sqrt 2.
+  std::string text;
+  float pts[6][2] = {{0, 0}, {0, 1}, {1, 1}, {1, 2}, {2, 2}, {2, 0}};
+  for (auto& p : pts)
+    text += "v " + std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[0]) + "\n";
+  text += "f 1 2 3 4 5 6\n";
+  mesh_data m = load_obj(dir.write("l.obj", text));
+  check_invariants(m);
+  REQUIRE(triangle_count(m) == 4);
+  float area = 0;
+  for (int t = 0; t < 4; t++) {
+    vec3f a = area_vector(m, t);
+    CHECK(a.x > 0);
+    CHECK(a.z < 0);
+    area += 0.5f * length(a);
+  }
+  CHECK(area == Approx(3.0f * std::sqrt(2.0f)));
+}
+
+TEST_CASE("negative indices count back from the latest element", "[obj]") {
+  temp_dir dir;
+  auto obj = dir.write("neg.obj", "v 5 5 5\n" + std::string(square_vertices) +
+                                      "vt 0 0\nvt 1 0\nvt 1 1\n"
+                                      "f -4/-3 -3/-2 -2/-1\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  REQUIRE(triangle_count(m) == 1);
+  CHECK(corner(m, 0, 0).x == 0.0f);
+  CHECK(corner(m, 0, 1).x == 1.0f);
+  CHECK(corner(m, 0, 2).y == 1.0f);
+  CHECK(m.positions.size() == 3);  // the unused vertices are compacted away
+  CHECK(m.texcoords[size_t(m.tri_texcoords[2])].x == 1.0f);
+}
+
+TEST_CASE("corners of the forms v//vn and v/vt/vn carry unit normals and texcoords", "[obj]") {
+  temp_dir dir;
+  auto obj = dir.write("n.obj", std::string(square_vertices) +
+                                    "vt 0.25 0.5\nvt 0.75 0.5 0\nvn 0 0 2\nvn 0 0 0\nvn 1e-30 0 0\n"
+                                    "f 1//1 2//2 3//3\nf 1/1/1 3/2/1 4/1/2\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  REQUIRE(triangle_count(m) == 2);
+  REQUIRE(m.normals.size() == 2);  // vn 0 0 0 is absent, the tiny one is kept
+  CHECK(m.normals[size_t(m.tri_normals[0])].z == 1.0f);
+  CHECK(m.tri_normals[1] == invalid_id);
+  CHECK(m.normals[size_t(m.tri_normals[2])].x == 1.0f);
+  for (int c = 0; c < 3; c++) CHECK(m.tri_texcoords[size_t(c)] == invalid_id);
+  CHECK(m.texcoords[size_t(m.tri_texcoords[3])].x == 0.25f);
+  CHECK(m.texcoords[size_t(m.tri_texcoords[4])].x == 0.75f);
+  CHECK(m.tri_normals[5] == invalid_id);
+}
+
+TEST_CASE("materials read Kd Ks Ns and Ke and faces without one get the default", "[obj]") {
+  temp_dir dir;
+  dir.write("m.mtl",
+            "# comment\nnewmtl red\n  Kd 0.5 0.25 0.125 # inline comment\n\tKs 0.1\nNs 20\nKa 0 0 0\nillum 2\n"
+            "newmtl lamp\nKe 10 8 6\nd 1\nPr 0.5\n");
+  auto obj = dir.write("m.obj", "mtllib m.mtl\n" + std::string(square_vertices) +
+                                    "f 1 2 3\nusemtl lamp\nf 1 3 4\nusemtl red\nf 1 2 4\nusemtl lamp\nf 2 3 4\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  REQUIRE(m.materials.size() == 3);  // lamp, red (order of first use), then the default
+  CHECK(m.materials[0].name == "lamp");
+  CHECK(m.materials[0].ke.x == 10.0f);
+  CHECK(m.materials[0].ke.z == 6.0f);
+  CHECK(m.materials[1].name == "red");
+  CHECK(m.materials[1].kd.y == 0.25f);
+  CHECK(m.materials[1].ks.z == 0.1f);  // one value means grey
+  CHECK(m.materials[1].ns == 20.0f);
+  CHECK(is_black(m.materials[1].ke));
+  CHECK(m.materials[2].kd.x == 0.8f);
+  CHECK(m.materials[2].kd_texture == invalid_id);
+  REQUIRE(triangle_count(m) == 4);
+  CHECK(m.tri_materials == std::vector<int>{2, 0, 1, 0});
+}
+
+TEST_CASE("a file without usemtl has only the default material", "[obj]") {
+  temp_dir dir;
+  mesh_data m = load_obj(dir.write("plain.obj", std::string(square_vertices) + "f 1 2 3 4\n"));
+  REQUIRE(m.materials.size() == 1);
+  CHECK(m.materials[0].kd.y == 0.8f);
+  CHECK(m.tri_materials == std::vector<int>{0, 0});
+}
+
+TEST_CASE("map_Kd and map_d are resolved beside the MTL and decoded once", "[obj]") {
+  temp_dir dir;
+  std::filesystem::create_directory(dir.path + "/mats");
+  std::filesystem::create_directory(dir.path + "/mats/tex");
+  write_png(dir, "mats/tex/a.png");
+  dir.write("mats/lib.mtl",
+            "newmtl leaf\nmap_Kd -s 1 1 1 -clamp off tex/a.png\nmap_d tex/a.png\n"
+            "newmtl bark\nKd 0.2 0.2 0.2\nmap_Kd tex/a.png\n");
+  auto obj = dir.write("t.obj", "mtllib mats/lib.mtl\n" + std::string(square_vertices) +
+                                    "vt 0.25 0.5\nusemtl leaf\nf 1/1 2/1 3/1\nusemtl bark\nf 1 3 4\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  REQUIRE(m.textures.size() == 1);  // one distinct path
+  REQUIRE(m.materials.size() == 2);
+  CHECK(m.materials[0].kd_texture == 0);
+  CHECK(m.materials[0].alpha_texture == 0);
+  CHECK(m.materials[1].kd_texture == 0);
+  CHECK(m.materials[1].alpha_texture == invalid_id);
+  const texture_data& t = m.textures[0];
+  CHECK(t.path == dir.path + "/mats/tex/a.png");
+  REQUIRE(t.width == 2);
+  CHECK(t.rgb[0].x == Approx(0.2158605f).margin(1e-7));
+  CHECK(t.alpha[0] == 1.0f);
+  CHECK(t.alpha[1] == 0.0f);
+  CHECK(eval_texture_alpha(t, {0.9f, 0.5f}) == 0.0f);
+}
+
+TEST_CASE("degenerate triangles are dropped and counted", "[obj]") {
+  temp_dir dir;
+  auto obj = dir.write("deg.obj", std::string(square_vertices) +
+                                      "v 2 0 0\nv 1 1 0\n"  // 5 is collinear with 1 and 2; 6 repeats 3
+                                      "f 1 2 3\nf 1 2 5\nf 3 3 4\nf 3 6 4\nf 1 2 3 4\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  CHECK(triangle_count(m) == 3);
+  CHECK(m.dropped_degenerate == 3);
+}
+
+TEST_CASE("odd but legal files from real tools load", "[obj]") {
+  temp_dir dir;
+  // BOM, CRLF and lone CR line endings, tabs, groups, smoothing, lines, points, vp, w, vertex colours,
+  // unknown statements (a warning, not an error), usemtl before its mtllib, a material name with a space.
+  dir.write("odd.mtl", "newmtl my mat\r\nKd 1 1 1\r\n");
+  auto obj = dir.write("odd.obj",
+                       "\xEF\xBB\xBF# exported\r\nusemtl my mat\r\nmtllib odd.mtl\r\no thing\rg a b\ns off\ns 1\n"
+                       "v\t0 0 0 1\nv 1 0 0 0.5 0.5 0.5\nv 1 1 0\nvp 0.5\nl 1 2\np 1\ncstype bezier\n"
+                       "f 1 2 3 # trailing comment\nfoo bar\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  CHECK(triangle_count(m) == 1);
+  REQUIRE(m.materials.size() == 1);
+  CHECK(m.materials[0].name == "my mat");
+  CHECK(m.materials[0].kd.x == 1.0f);
+}
+
+TEST_CASE("the subdivided Cornell box layout loads", "[obj]") {
+  // Statement shapes of a real exported scene: mtllib first, o/usemtl per object, quads.
+  temp_dir dir;
+  dir.write("box.mtl",
+            "newmtl White\nKd 0.73 0.73 0.73\nKa 0.0000 0.0000 0.0000\nKs 0.0000 0.0000 0.0000\n"
+            "illum 1\n\nnewmtl Light\nKd 0.78 0.78 0.78\nKe 18.4 15.6 8\nillum 1\n");
+  auto obj = dir.write("box.obj", "# Cornell\nmtllib box.mtl\n\n" + std::string(square_vertices) +
+                                      "v 0 0 1\nv 1 0 1\n\no floor\nusemtl White\nf 1 2 3 4\n"
+                                      "o light\nusemtl Light\nf 1 5 6 2\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  CHECK(triangle_count(m) == 4);
+  CHECK(m.materials[1].ke.y == 15.6f);
+}
+
+TEST_CASE("a missing OBJ or a directory is an input error naming it", "[obj]") {
+  temp_dir dir;
+  CHECK_THAT(load_error(dir.path + "/nope.obj"), Catch::Contains("nope.obj: cannot open OBJ file"));
+  CHECK_THAT(load_error(dir.path), Catch::Contains("not a regular file"));
+}
+
+TEST_CASE("malformed statements are input errors with file and line", "[obj]") {
+  temp_dir dir;
+  struct bad_case {
+    const char* body;
+    int line;
+    const char* says;
+  };
+  const bad_case cases[] = {
+      {"v 0 0 0\nv 1 0.5x 0\n", 2, "malformed number '0.5x'"},
+      {"v 0 0 0\nv nan 0 0\n", 2, "non-finite number 'nan'"},
+      {"v 0 0 0\nv 0 -inf 0\n", 2, "non-finite number '-inf'"},
+      {"v 1e39 0 0\n", 1, "out of range"},
+      {"v 0e999 0 0\n", 1, "out of range"},
+      {"v . 0 0\n", 1, "malformed number '.'"},
+      {"v 1 2\n", 1, "takes 3 numbers"},
+      {"vn 0 0 1 0\n", 1, "takes 3 numbers"},
+      {"vt\n", 1, "takes 1 to 3 numbers"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", 4, "vertex index '4' out of range (3 vertices"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", 4, "index 0 is invalid"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", 4, "out of range"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n", 4, "texcoord index '1' out of range"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2 3\n", 4, "normal index '1' out of range"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3.0\n", 4, "malformed vertex index '3.0'"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/\n", 4, "malformed texcoord index ''"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/1/1/1\n", 4, "malformed face corner"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", 4, "out of range"},
+      {"v 0 0 0\nv 1 0 0\nf 1 2\n", 3, "at least 3 vertices"},
+      {"v 0 0 0\n\rv 0 \0 0\n", 3, "NUL byte"},
+      {"usemtl\n", 1, "usemtl needs a material name"},
+      {"mtllib\n", 1, "mtllib needs a file name"},
+  };
+  for (const auto& c : cases) {
+    std::string body(c.body, c.body + std::char_traits<char>::length(c.body));
+    if (std::string(c.says) == "NUL byte") body = std::string("v 0 0 0\n\rv 0 \0 0\n", 17);
+    auto obj = dir.write("bad.obj", body);
+    INFO(c.body);
+    CHECK_THAT(load_error(obj), Catch::Contains(obj + ":" + std::to_string(c.line) + ": ") && Catch::Contains(c.says));
+  }
+}
+
+TEST_CASE("material library errors name the MTL file and line", "[obj]") {
+  temp_dir dir;
+  const std::string faces = std::string(square_vertices) + "usemtl a\nf 1 2 3\n";
+  auto obj_for = [&](const std::string& mtl) {
+    dir.write("lib.mtl", mtl);
+    return dir.write("o.obj", "mtllib lib.mtl\n" + faces);
+  };
+  const std::string mtl = dir.path + "/lib.mtl";
+  CHECK_THAT(load_error(obj_for("newmtl a\nKd 0.5 0.5\n")), Catch::Contains(mtl + ":2: 'Kd' takes 1 or 3 numbers"));
+  CHECK_THAT(load_error(obj_for("newmtl a\nKd 0.5 -1 0\n")), Catch::Contains(mtl + ":2: 'Kd' must not be negative"));
+  CHECK_THAT(load_error(obj_for("newmtl a\nKe 1 nan 1\n")), Catch::Contains(mtl + ":2: non-finite number 'nan'"));
+  CHECK_THAT(load_error(obj_for("Kd 1 1 1\nnewmtl a\n")), Catch::Contains(mtl + ":1: 'Kd' before any newmtl"));
+  CHECK_THAT(load_error(obj_for("newmtl a\nd 1.5\n")), Catch::Contains(mtl + ":2: 'd' must lie in [0, 1]"));
+  CHECK_THAT(load_error(obj_for("newmtl a\nNs -3\n")), Catch::Contains(mtl + ":2: Ns must not be negative"));
+  CHECK_THAT(load_error(obj_for("newmtl a\nNs 1 2\n")), Catch::Contains(mtl + ":2: 'Ns' takes 1 number"));
+  CHECK_THAT(load_error(obj_for("newmtl a\nmap_Kd -s 1 1 1\n")),
+             Catch::Contains(mtl + ":2: 'map_Kd' needs a file name"));
+  CHECK_THAT(load_error(obj_for("newmtl a\nmap_Kd -clamp maybe x.png\n")), Catch::Contains(mtl + ":2: texture option"));
+  CHECK_THAT(load_error(obj_for("newmtl\n")), Catch::Contains(mtl + ":1: newmtl needs a material name"));
+}
+
+TEST_CASE("a missing MTL or undefined material is an input error at its OBJ line", "[obj]") {
+  temp_dir dir;
+  auto obj = dir.write("a.obj", std::string(square_vertices) + "mtllib missing.mtl\nf 1 2 3\n");
+  CHECK_THAT(load_error(obj),
+             Catch::Contains(obj + ":5: mtllib: ") && Catch::Contains("missing.mtl: cannot open material library"));
+  dir.write("ok.mtl", "newmtl known\n");
+  obj = dir.write("b.obj",
+                  "mtllib ok.mtl\n" + std::string(square_vertices) + "usemtl known\nf 1 2 3\nusemtl ghost\nf 1 3 4\n");
+  CHECK_THAT(load_error(obj), Catch::Contains(obj + ":8: usemtl of undefined material 'ghost'"));
+}
+
+TEST_CASE("a missing or undecodable texture is an input error at its MTL line", "[obj]") {
+  temp_dir dir;
+  const std::string faces = "mtllib t.mtl\n" + std::string(square_vertices) + "usemtl a\nf 1 2 3\n";
+  dir.write("t.mtl", "newmtl a\nKd 1 1 1\nmap_Kd none.png\n");
+  auto obj = dir.write("t.obj", faces);
+  CHECK_THAT(load_error(obj),
+             Catch::Contains(dir.path + "/t.mtl:3: map_Kd: ") && Catch::Contains("none.png: cannot open image"));
+  dir.write("junk.png", "\x89PNG\r\n\x1a\n this is not a png");
+  dir.write("t.mtl", "newmtl a\nmap_d junk.png\n");
+  CHECK_THAT(load_error(obj),
+             Catch::Contains(dir.path + "/t.mtl:2: map_d: ") && Catch::Contains("junk.png: cannot decode image"));
+  // An unused material's texture is never opened.
+  dir.write("t.mtl", "newmtl a\nnewmtl unused\nmap_Kd none.png\n");
+  CHECK(load_error(obj).empty());
+}
+
+TEST_CASE("files without triangles are input errors", "[obj]") {
+  temp_dir dir;
+  auto empty = dir.write("empty.obj", "");
+  CHECK_THAT(load_error(empty), Catch::Equals(empty + ": no triangles"));
+  CHECK_THAT(load_error(dir.write("verts.obj", square_vertices)), Catch::EndsWith(": no triangles"));
+  CHECK_THAT(load_error(dir.write("flat.obj", std::string(square_vertices) + "f 1 1 2\n")),
+             Catch::EndsWith("no triangles (1 degenerate dropped)"));
+}
+
+TEST_CASE("hostile input ends in an input error or a mesh", "[obj]") {
+  temp_dir dir;
+  // A 10 MB line of digits, a huge face, binary garbage, absurd numbers: none may crash or hang.
+  CHECK_THAT(load_error(dir.write("long.obj", "v " + std::string(10'000'000, '7') + " 0 0\n")),
+             Catch::Contains("number too long"));
+  std::string big_face = std::string(square_vertices) + "f";
+  for (int i = 0; i < 200000; i++) big_face += " " + std::to_string(1 + i % 4);
+  auto big = dir.write("big.obj", big_face + "\n");
+  std::string err = load_error(big);
+  CHECK((err.empty() || err.find("no triangles") != std::string::npos));
+  std::string garbage;
+  for (int i = 0; i < 100000; i++) garbage += char((i * 7919 + i / 13) % 256);
+  CHECK_FALSE(load_error(dir.write("garbage.obj", garbage)).empty());
+  CHECK_THAT(load_error(dir.write("exp.obj", "v 1e-99999999999999 0 0\n")), Catch::Contains("out of range"));
+  // Finite but enormous coordinates: triangles whose area overflows float are dropped as non-finite.
+  mesh_data m =
+      load_obj(dir.write("huge.obj", "v 0 0 0\nv 3e38 0 0\nv 0 3e38 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 4 5\n"));
+  CHECK(triangle_count(m) == 1);
+  CHECK(m.dropped_degenerate == 1);
+}

@@ -1,0 +1,158 @@
+// Tests of sampling warps against their pdfs (chi-square of histograms against the pdf integrated per
+// cell, nori style) and of discrete distributions. Every test is seeded; significance 1e-3 per test.
+#include "rng.h"
+#include "sampling.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+#include <functional>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+constexpr double alpha = 1e-3;  // chi-square significance level of every test here
+
+// Uniform pair number i of a seeded stream.
+vec2f uniform_pair(uint64_t seed, uint64_t i) {
+  auto r = draw_vertex(sample_key(seed, i, 0), 1);
+  return {r.u[0], r.u[1]};
+}
+
+// Chi-square test of a direction warp: histogram over (cos theta, phi) cells against the pdf integrated
+// over each cell by a midpoint rule (pdf is solid angle; d omega = d cos_theta d phi).
+double direction_pvalue(const std::function<vec3f(vec2f)>& warp, const std::function<float(vec3f)>& pdf,
+                        float cos_lo, int n_theta, int n_phi, int samples, uint64_t seed) {
+  std::vector<double> obs(size_t(n_theta) * n_phi, 0.0), exp(obs.size(), 0.0);
+  for (int i = 0; i < samples; i++) {
+    vec3f d = warp(uniform_pair(seed, uint64_t(i)));
+    float c = d.z;
+    if (c < cos_lo) {
+      obs[0] += 1e9;  // outside the support: guaranteed failure
+      continue;
+    }
+    int it = std::min(n_theta - 1, int((c - cos_lo) / (1 - cos_lo) * n_theta));
+    float phi = std::atan2(d.y, d.x);
+    if (phi < 0) phi += 2 * pi_f;
+    int ip = std::min(n_phi - 1, int(phi / (2 * pi_f) * n_phi));
+    obs[size_t(it) * n_phi + ip] += 1;
+  }
+  const int sub = 16;
+  double dc = (1.0 - cos_lo) / n_theta, dp = 2 * M_PI / n_phi;
+  for (int it = 0; it < n_theta; it++)
+    for (int ip = 0; ip < n_phi; ip++) {
+      double acc = 0;
+      for (int a = 0; a < sub; a++)
+        for (int b = 0; b < sub; b++) {
+          double c = cos_lo + (it + (a + 0.5) / sub) * dc;
+          double phi = (ip + (b + 0.5) / sub) * dp;
+          double s = std::sqrt(std::max(0.0, 1 - c * c));
+          acc += pdf(vec3f{float(s * std::cos(phi)), float(s * std::sin(phi)), float(c)});
+        }
+      exp[size_t(it) * n_phi + ip] = acc / (sub * sub) * dc * dp * samples;
+    }
+  return chi2_pvalue(obs, exp);
+}
+
+}  // namespace
+
+TEST_CASE("cosine hemisphere samples follow cos over pi", "[sampling]") {
+  double p = direction_pvalue([](vec2f u) { return sample_cosine_hemisphere(u.x, u.y); },
+                              [](vec3f d) { return cosine_hemisphere_pdf(d.z); }, 0, 10, 20, 200000, 1);
+  CHECK(p > alpha);
+}
+
+TEST_CASE("cone samples are uniform in the cone", "[sampling]") {
+  float half = 25 * pi_f / 180;
+  float omc = 1 - std::cos(half);
+  double p = direction_pvalue([omc](vec2f u) { return sample_cone(u.x, u.y, omc); },
+                              [omc](vec3f d) { return 1 - d.z <= omc ? cone_pdf(omc) : 0.0f; },
+                              std::cos(half), 8, 16, 100000, 2);
+  CHECK(p > alpha);
+}
+
+TEST_CASE("sun sized cones stay inside their half angle with a normalised pdf", "[sampling]") {
+  // 0.53 degree disk: 1 - cos is 1.07e-5, so precision matters; all samples inside, pdf * solid angle = 1.
+  float half = 0.5f * 0.53f * pi_f / 180;
+  float s = std::sin(0.5f * half);
+  float omc = 2 * s * s;
+  for (int i = 0; i < 10000; i++) {
+    vec2f u = uniform_pair(3, uint64_t(i));
+    vec3f d = sample_cone(u.x, u.y, omc);
+    REQUIRE(std::fabs(length(d) - 1) < 1e-5f);
+    REQUIRE(1 - d.z <= omc * 1.001f);
+  }
+  double solid_angle = 2 * M_PI * (1 - std::cos(double(half)));
+  CHECK(double(cone_pdf(omc)) * solid_angle == Approx(1.0).epsilon(1e-4));
+}
+
+TEST_CASE("phong lobe samples follow their pdf", "[sampling]") {
+  for (float n : {1.0f, 10.0f, 80.0f}) {
+    double p = direction_pvalue([n](vec2f u) { return sample_phong_lobe(u.x, u.y, n); },
+                                [n](vec3f d) { return phong_lobe_pdf(d.z, n); }, 0, 12, 12, 150000,
+                                uint64_t(4 + n));
+    CHECK(p > alpha);
+  }
+}
+
+TEST_CASE("triangle samples are uniform over the triangle", "[sampling]") {
+  // Cells of an n x n grid over (b1, b2): inside cells get 2/n^2 of the samples, diagonal ones half that.
+  const int n = 16, samples = 200000;
+  std::vector<double> obs(n * n, 0.0), exp(n * n, 0.0);
+  for (int i = 0; i < samples; i++) {
+    vec2f u = uniform_pair(5, uint64_t(i));
+    vec2f b = sample_triangle(u.x, u.y);
+    REQUIRE(b.x >= 0);
+    REQUIRE(b.y >= 0);
+    REQUIRE(b.x + b.y <= 1.0f);
+    int ix = std::min(n - 1, int(b.x * n)), iy = std::min(n - 1, int(b.y * n));
+    obs[size_t(iy) * n + ix] += 1;
+  }
+  for (int iy = 0; iy < n; iy++)
+    for (int ix = 0; ix < n; ix++) {
+      double frac = ix + iy < n - 1 ? 1.0 : (ix + iy == n - 1 ? 0.5 : 0.0);
+      exp[size_t(iy) * n + ix] = samples * frac * 2.0 / (n * n);
+    }
+  CHECK(chi2_pvalue(obs, exp) > alpha);
+}
+
+TEST_CASE("discrete distributions sample their pmf and never pick zero weights", "[sampling]") {
+  std::vector<float> w = {0, 3, 0.5f, 0, 10, 1e-3f, 2, 0};
+  discrete_data d = make_discrete(w.data(), int(w.size()));
+  double total = 0;
+  for (size_t i = 0; i < w.size(); i++) total += discrete_pmf(d, int(i));
+  CHECK(total == Approx(1.0).epsilon(1e-6));
+  for (size_t i = 0; i < w.size(); i++) {
+    if (w[i] == 0) CHECK(discrete_pmf(d, int(i)) == 0);
+    else CHECK(std::fabs(discrete_pmf(d, int(i)) - w[i] / 15.501) < 2.5e-7);  // float cdf resolution near 1
+  }
+  const int samples = 300000;
+  std::vector<double> obs(w.size(), 0.0), exp(w.size(), 0.0);
+  for (int i = 0; i < samples; i++) {
+    int k = sample_discrete(d, uniform_pair(6, uint64_t(i)).x);
+    REQUIRE(k >= 0);
+    REQUIRE(w[size_t(k)] > 0);
+    obs[size_t(k)] += 1;
+  }
+  for (size_t i = 0; i < w.size(); i++) exp[i] = samples * double(discrete_pmf(d, int(i)));
+  CHECK(chi2_pvalue(obs, exp) > alpha);
+  // The extreme ends of [0, 1) map onto positive-weight items.
+  CHECK(w[size_t(sample_discrete(d, 0.0f))] > 0);
+  CHECK(w[size_t(sample_discrete(d, 0x1.fffffep-1f))] > 0);
+}
+
+TEST_CASE("an all zero distribution is empty", "[sampling]") {
+  std::vector<float> w = {0, 0, 0};
+  discrete_data d = make_discrete(w.data(), 3);
+  CHECK(sample_discrete(d, 0.5f) == -1);
+  CHECK(discrete_pmf(d, 1) == 0);
+}
+
+TEST_CASE("the power heuristic is a partition of unity", "[sampling]") {
+  CHECK(power_heuristic(1, 1) == Approx(0.5));
+  CHECK(power_heuristic(3, 1) + power_heuristic(1, 3) == Approx(1.0));
+  CHECK(power_heuristic(0, 1) == 0);
+  CHECK(power_heuristic(inf_f, 1) == 1);
+}

@@ -1,0 +1,203 @@
+// Tests of texture decoding and lookup: the sRGB table, channel handling (alpha from grey or from an alpha
+// channel), 16-bit images, repeat wrap, v = 0 at the bottom row, bilinear weights, and hostile files.
+#include "errors.h"
+#include "texture.h"
+
+#include <catch2/catch.hpp>
+#include <stb_image_write.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+using namespace bl;
+
+namespace {
+
+// A fresh temporary directory, removed with everything in it at the end of the test.
+struct temp_dir {
+  std::string path;
+  temp_dir() {
+    char tmpl[] = "/tmp/bl_texture_test_XXXXXX";
+    REQUIRE(mkdtemp(tmpl) != nullptr);
+    path = tmpl;
+  }
+  ~temp_dir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  std::string file(const std::string& name) const { return path + "/" + name; }
+};
+
+// Writes raw bytes to a file.
+void write_bytes(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
+
+// Writes a w x h PNG with n 8-bit channels per pixel, rows top first.
+std::string write_png(const temp_dir& dir, const std::string& name, int w, int h, int n,
+                      const std::vector<unsigned char>& px) {
+  std::string path = dir.file(name);
+  REQUIRE(stbi_write_png(path.c_str(), w, h, n, px.data(), w * n) != 0);
+  return path;
+}
+
+// The message of the input_error that loading path throws ("" when it loads).
+std::string texture_error(const std::string& path) {
+  try {
+    load_texture(path);
+  } catch (const input_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A 2x1 16-bit grey+alpha PNG: texel 0 grey 0x8080 alpha 0xffff, texel 1 grey 0xffff alpha 0.
+const unsigned char png16[] = {0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44,
+                               0x52, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x01, 0x10, 0x04, 0x00, 0x00, 0x00, 0x0e,
+                               0xbb, 0x6b, 0x42, 0x00, 0x00, 0x00, 0x0f, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0x68,
+                               0x68, 0xf8, 0x0f, 0x04, 0x0c, 0x0c, 0x00, 0x19, 0x77, 0x04, 0xfd, 0x7c, 0xba, 0x30, 0x17,
+                               0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+
+}  // namespace
+
+TEST_CASE("srgb8_to_linear follows the sRGB curve", "[texture]") {
+  CHECK(srgb8_to_linear(0) == 0.0f);
+  CHECK(srgb8_to_linear(255) == Approx(1.0f).margin(1e-6));
+  CHECK(srgb8_to_linear(128) == Approx(0.2158605f).margin(1e-7));
+  CHECK(srgb8_to_linear(10) == Approx(10.0f / 255.0f / 12.92f).margin(1e-9));  // linear segment
+  for (int v = 1; v < 256; v++) CHECK(srgb8_to_linear((unsigned char)v) > srgb8_to_linear((unsigned char)(v - 1)));
+}
+
+TEST_CASE("an RGB PNG decodes to linear texels top row first", "[texture]") {
+  temp_dir dir;
+  // 1x2: top texel sRGB 128 grey, bottom texel pure red.
+  auto path = write_png(dir, "a.png", 1, 2, 3, {128, 128, 128, 255, 0, 0});
+  texture_data t = load_texture(path);
+  REQUIRE(t.width == 1);
+  REQUIRE(t.height == 2);
+  CHECK(t.path == path);
+  CHECK(t.rgb[0].x == srgb8_to_linear(128));
+  CHECK(t.rgb[1].x == 1.0f);
+  CHECK(t.rgb[1].y == 0.0f);
+  // Without an alpha channel the mask is the first channel, linear.
+  CHECK(t.alpha[0] == Approx(128.0f / 255.0f));
+  CHECK(t.alpha[1] == 1.0f);
+}
+
+TEST_CASE("v equal to zero is the bottom row of the image", "[texture]") {
+  temp_dir dir;
+  auto path = write_png(dir, "rows.png", 1, 2, 1, {255, 0});  // top white, bottom black
+  texture_data t = load_texture(path);
+  CHECK(eval_texture_rgb(t, {0.5f, 0.25f}).x == 0.0f);  // centre of the bottom row
+  CHECK(eval_texture_rgb(t, {0.5f, 0.75f}).x == 1.0f);  // centre of the top row
+  CHECK(eval_texture_alpha(t, {0.5f, 0.1f}) == 0.0f);
+  CHECK(eval_texture_alpha(t, {0.5f, 0.9f}) == 1.0f);
+}
+
+TEST_CASE("bilinear lookup weighs the two nearest texel centres", "[texture]") {
+  temp_dir dir;
+  auto path = write_png(dir, "ramp.png", 2, 1, 1, {0, 255});  // linear 0 and 1
+  texture_data t = load_texture(path);
+  CHECK(eval_texture_rgb(t, {0.25f, 0.5f}).x == 0.0f);            // centre of texel 0
+  CHECK(eval_texture_rgb(t, {0.75f, 0.5f}).x == 1.0f);            // centre of texel 1
+  CHECK(eval_texture_rgb(t, {0.5f, 0.5f}).x == Approx(0.5f));     // midpoint
+  CHECK(eval_texture_rgb(t, {0.375f, 0.5f}).x == Approx(0.25f));  // a quarter of the way
+  CHECK(eval_texture_rgb(t, {0.0f, 0.5f}).x == Approx(0.5f));     // the seam blends with the wrapped texel
+  CHECK(eval_texture_alpha(t, {0.49f, 0.5f}) == 0.0f);            // nearest, no blending
+  CHECK(eval_texture_alpha(t, {0.51f, 0.5f}) == 1.0f);
+}
+
+TEST_CASE("lookups repeat and survive huge negative and NaN coordinates", "[texture]") {
+  temp_dir dir;
+  auto path = write_png(dir, "wrap.png", 4, 3, 3,
+                        {10,  20,  30,  40,  50,  60,  70,  80, 90, 100, 110, 120, 130, 140, 150, 160, 170, 180,
+                         190, 200, 210, 220, 230, 240, 250, 5,  15, 25,  35,  45,  55,  65,  75,  85,  95,  105});
+  texture_data t = load_texture(path);
+  for (float u : {0.1f, 0.3f, 0.62f, 0.9f})
+    for (float v : {0.2f, 0.5f, 0.8f}) {
+      vec3f a = eval_texture_rgb(t, {u, v});
+      vec3f b = eval_texture_rgb(t, {u + 3.0f, v - 2.0f});
+      CHECK(a.x == Approx(b.x).margin(1e-5));
+      CHECK(a.z == Approx(b.z).margin(1e-5));
+      CHECK(eval_texture_alpha(t, {u, v}) == eval_texture_alpha(t, {u - 5.0f, v + 7.0f}));
+    }
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (vec2f uv : {vec2f{nan, nan}, vec2f{inf, -inf}, vec2f{1e30f, -1e30f}, vec2f{-1e-9f, -1e-9f}}) {
+    vec3f c = eval_texture_rgb(t, uv);
+    CHECK(is_finite(c));
+    CHECK(c.x >= 0.0f);
+    CHECK(c.x <= 1.0f);
+    float a = eval_texture_alpha(t, uv);
+    CHECK(a >= 0.0f);
+    CHECK(a <= 1.0f);
+  }
+  // NaN is treated as 0.
+  CHECK(eval_texture_alpha(t, {nan, nan}) == eval_texture_alpha(t, {0.0f, 0.0f}));
+  CHECK(eval_texture_rgb(t, {nan, 0.3f}).y == eval_texture_rgb(t, {0.0f, 0.3f}).y);
+}
+
+TEST_CASE("alpha comes from the alpha channel when there is one and from grey otherwise", "[texture]") {
+  temp_dir dir;
+  texture_data grey = load_texture(write_png(dir, "g.png", 1, 1, 1, {51}));
+  texture_data grey_alpha = load_texture(write_png(dir, "ga.png", 1, 1, 2, {51, 204}));
+  texture_data rgba = load_texture(write_png(dir, "rgba.png", 1, 1, 4, {255, 0, 0, 102}));
+  CHECK(grey.alpha[0] == Approx(0.2f));
+  CHECK(grey.rgb[0].y == srgb8_to_linear(51));
+  CHECK(grey_alpha.alpha[0] == Approx(0.8f));
+  CHECK(grey_alpha.rgb[0].z == srgb8_to_linear(51));
+  CHECK(rgba.alpha[0] == Approx(0.4f));
+  CHECK(rgba.rgb[0].x == 1.0f);
+  CHECK(rgba.rgb[0].y == 0.0f);
+}
+
+TEST_CASE("16-bit images decode through the same sRGB curve", "[texture]") {
+  temp_dir dir;
+  write_bytes(dir.file("p16.png"), std::string(reinterpret_cast<const char*>(png16), sizeof png16));
+  texture_data t = load_texture(dir.file("p16.png"));
+  REQUIRE(t.width == 2);
+  REQUIRE(t.height == 1);
+  float c = 32896.0f / 65535.0f;
+  CHECK(t.rgb[0].x == Approx(std::pow((c + 0.055) / 1.055, 2.4)).epsilon(1e-6));
+  CHECK(t.rgb[1].x == 1.0f);
+  CHECK(t.alpha[0] == 1.0f);
+  CHECK(t.alpha[1] == 0.0f);
+}
+
+TEST_CASE("missing garbage truncated and unsupported images are input errors", "[texture]") {
+  temp_dir dir;
+  CHECK_THAT(texture_error(dir.file("none.png")), Catch::Contains("none.png") && Catch::Contains("cannot open"));
+  CHECK_THAT(texture_error(dir.path), Catch::Contains("not a regular file"));
+  write_bytes(dir.file("empty.png"), "");
+  CHECK_THAT(texture_error(dir.file("empty.png")), Catch::Contains("empty.png: cannot decode"));
+  std::string garbage;
+  for (int i = 0; i < 5000; i++) garbage += char((i * 7919 + 13) % 251);
+  write_bytes(dir.file("garbage.png"), garbage);
+  CHECK_THAT(texture_error(dir.file("garbage.png")), Catch::Contains("garbage.png: cannot decode"));
+  // A real PNG cut after its header, and one with its pixel data corrupted.
+  std::vector<unsigned char> px(64 * 64 * 3);
+  for (size_t i = 0; i < px.size(); i++) px[i] = (unsigned char)(i * 31);
+  auto good = write_png(dir, "good.png", 64, 64, 3, px);
+  std::ifstream in(good, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  write_bytes(dir.file("cut.png"), bytes.substr(0, 60));
+  CHECK_THAT(texture_error(dir.file("cut.png")), Catch::Contains("cut.png: cannot decode"));
+  std::string corrupt = bytes;
+  for (size_t i = 60; i < corrupt.size(); i += 3) corrupt[i] = char(corrupt[i] ^ 0x5a);
+  write_bytes(dir.file("corrupt.png"), corrupt);
+  CHECK_THAT(texture_error(dir.file("corrupt.png")), Catch::Contains("corrupt.png: cannot decode"));
+  // HDR and GIF are refused by name.
+  float hdr[3] = {1, 2, 3};
+  REQUIRE(stbi_write_hdr(dir.file("sky.hdr").c_str(), 1, 1, 3, hdr) != 0);
+  CHECK_THAT(texture_error(dir.file("sky.hdr")), Catch::Contains("unsupported image format HDR"));
+  write_bytes(dir.file("anim.gif"), "GIF89a\x01\x00\x01\x00");
+  CHECK_THAT(texture_error(dir.file("anim.gif")), Catch::Contains("unsupported image format GIF"));
+}
+
+TEST_CASE("an empty texture looks up as black and opaque", "[texture]") {
+  texture_data t;
+  CHECK(is_black(eval_texture_rgb(t, {0.5f, 0.5f})));
+  CHECK(eval_texture_alpha(t, {0.5f, 0.5f}) == 1.0f);
+}
