@@ -5,17 +5,22 @@ namespace bl {
 
 void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   locate_region(ctx, regions, sp);
+  if (ctx.count == 1) {
+    // One cluster: its probability is 1 whatever was learned (and nothing is recorded for it).
+    ctx.cdf[0] = 0;
+    ctx.cdf[1] = 1;
+    return;
+  }
   size_t base = size_t(regions.pair_offset[size_t(ctx.region)]);
   // Prior scale: a Lambertian point of albedo a turns irradiance E into radiance a E / pi.
   double scale = (sp.albedo > 0 ? sp.albedo : 1.0f) * inv_pi_f;
   double w[max_cut_entries], b[max_cut_entries];
   double sum_w = 0, sum_b = 0;
   for (int j = 0; j < ctx.count; j++) {
-    int node = ctx.nodes[j];
-    float bound = cluster_bound(*tree, *lights, node, sp.p, sp.n, sun_sin, sun_cos);
-    float d = params.distance_regression ? cluster_distance(*tree, node, sp.p) : 1.0f;
-    size_t i = base + size_t(j);
-    w[j] = posterior_weight(params, bound, scale, d, stats.n0[i], stats.n1[i], stats.mean[i], stats.m2[i]);
+    float inv_d2;
+    float num = cluster_bound_parts(*tree, *lights, ctx.nodes[j], sp.p, sp.n, sun_sin, sun_cos, inv_d2);
+    double bound = double(num) * inv_d2;
+    w[j] = eval_weight(stats, base + size_t(j), params, scale * bound, params.distance_regression ? inv_d2 : 1.0);
     b[j] = bound;
     sum_w += w[j];
     sum_b += b[j];
@@ -31,7 +36,7 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   const cut_context& ctx = *e.context;
   row.requests.add(regions, ctx);
   int j = e.choice.cluster;
-  if (j < 0) return;
+  if (j < 0 || ctx.count == 1) return;
   double z = e.value;
   if (z > 0 && params.distance_regression) {
     double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
@@ -41,11 +46,11 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
 }
 
 void bayes_sampler::learn(std::vector<row_state>& rows) {
-  merge_rows(stats, rows);
+  merge_rows(stats, rows, params);
   std::vector<const region_requests*> r;
   for (const row_state& row : rows) r.push_back(&row.requests);
   create_requested_regions(regions, *tree, r);
-  resize_stats(stats, regions.pairs);
+  resize_stats(stats, regions.pairs, params);
 }
 
 }  // namespace bl

@@ -8,20 +8,72 @@
 
 namespace bl {
 
-void resize_stats(bayes_stats& s, int64_t pairs) {
-  size_t n = size_t(pairs);
+void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
+  size_t old = s.n0.size(), n = size_t(pairs);
   s.n0.resize(n, 0.0);
   s.n1.resize(n, 0.0);
   s.mean.resize(n, 0.0);
   s.m2.resize(n, 0.0);
+  s.q2.resize(n);
+  s.q1.resize(n);
+  s.q0.resize(n);
+  s.qc.resize(n);
+  if (n > old) {
+    // All empty pairs share the prior-only coefficients.
+    update_coeffs(s, old, p);
+    for (size_t i = old + 1; i < n; i++) {
+      s.q2[i] = s.q2[old];
+      s.q1[i] = s.q1[old];
+      s.q0[i] = s.q0[old];
+      s.qc[i] = s.qc[old];
+    }
+  }
 }
 
-void decay_stats(bayes_stats& s, double gamma) {
+void decay_stats(bayes_stats& s, double gamma, const bayes_params& p) {
   for (size_t i = 0; i < s.n0.size(); i++) {
     s.n0[i] *= gamma;
     s.n1[i] *= gamma;
     s.m2[i] *= gamma;  // the mean is unchanged by scaling all weights
+    update_coeffs(s, i, p);
   }
+}
+
+void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
+  double n0 = s.n0[i], n1 = s.n1[i], z = s.mean[i], m2 = s.m2[i];
+  double q2, q1 = 0, q0 = 0, qc = 0;
+  if (!p.prior) {
+    // Naive plug-in moments; a pair without samples follows its bound (w = v).
+    double n = n0 + n1;
+    if (n == 0) {
+      q2 = 1.0;  // w = v (second moment: sqrt(v^2); mean only: v)
+    } else {
+      double p1 = n1 / n;
+      q2 = 0;
+      if (p.second_moment) q0 = p1 * (z * z + (n1 >= 2 ? m2 / n1 : 0.0));
+      else q1 = p1 * z;
+    }
+  } else {
+    // p1 = 1 - p0; mu_n = A mu0 + B; h = C mu0^2 + D + E (z - mu0)^2 (see bayes_stats.h).
+    double p1 = (p.b0 + n1) / (p.a0 + p.b0 + n0 + n1);
+    double kn = p.kappa0 + n1;
+    double a = p.kappa0 / kn, b = n1 * z / kn;
+    if (!p.second_moment) {
+      q2 = p1 * a;
+      q1 = p1 * b;
+    } else {
+      double am1 = p.alpha0 + 0.5 * n1 - 1;
+      double c = p.c * (p.alpha0 - 1) / am1, d = 0.5 * m2 / am1, e = 0.5 * p.kappa0 * n1 / (kn * am1);
+      q2 = p1 * (a * a + c + e);
+      q1 = p1 * (2 * a * b - 2 * e * z);
+      q0 = p1 * (b * b + d + e * z * z);
+      qc = p1 * c;
+    }
+  }
+  s.q2[i] = float(q2);
+  s.q1[i] = float(q1);
+  s.q0[i] = float(q0);
+  s.qc[i] = float(qc);
 }
 
 void bayes_row::clear() {
@@ -59,18 +111,22 @@ void bayes_row::add(int pair, double z) {
   a.m2 += delta * (z - a.mean);
 }
 
-void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows) {
+void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p) {
   for (const bayes_row& row : rows)
     for (const pair_accum& a : row.acc) {
       size_t i = size_t(a.pair);
       s.n0[i] += a.n0;
-      if (a.n1 == 0) continue;
-      double n = s.n1[i] + a.n1;
-      double delta = a.mean - s.mean[i];
-      s.mean[i] += delta * (a.n1 / n);
-      s.m2[i] += a.m2 + delta * delta * (s.n1[i] * a.n1 / n);
-      s.n1[i] = n;
+      if (a.n1 > 0) {
+        double n = s.n1[i] + a.n1;
+        double delta = a.mean - s.mean[i];
+        s.mean[i] += delta * (a.n1 / n);
+        s.m2[i] += a.m2 + delta * delta * (s.n1[i] * a.n1 / n);
+        s.n1[i] = n;
+      }
     }
+  // Coefficients once per touched pair (a pair may appear in many rows; recomputing is idempotent).
+  for (const bayes_row& row : rows)
+    for (const pair_accum& a : row.acc) update_coeffs(s, size_t(a.pair), p);
 }
 
 double posterior_weight(const bayes_params& p, double bound, double scale, double d, double n0, double n1,

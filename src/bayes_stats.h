@@ -8,6 +8,8 @@
 
 #include "cut_sampling.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -26,15 +28,29 @@ struct bayes_params {
   double decay = 1;              // statistics scale per animation frame (1: keep everything)
 };
 
-// Statistics columns, one entry per (region, cluster) pair.
+// Statistics columns, one entry per (region, cluster) pair, with the posterior folded into per-pair
+// coefficients. The posterior second moment mu_n^2 + h is a quadratic in the prior mean mu0; with the prior
+// mean of Y at the point v = scale * bound (so mu0 = v d^2) and g = 1 / d^2, the weight is
+//   w = sqrt(max(q2 v^2 + q1 v g + q0 g^2, qc v^2))       (qc v^2 = the prior-variance term, a lower bound)
+// and for the mean-only ablation w = q2 v + q1 g. Coefficients change only for pairs that got samples.
 struct bayes_stats {
   std::vector<double> n0, n1, mean, m2;
+  std::vector<float> q2, q1, q0, qc;
 };
 
-// Grows the columns to `pairs` entries (new pairs start empty).
-void resize_stats(bayes_stats& s, int64_t pairs);
+// Grows the columns to `pairs` entries (new pairs start empty, with prior-only coefficients).
+void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p);
+// Recomputes the coefficients of pair i from its statistics.
+void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p);
+// Weight of pair i for a point with prior mean v (= scale * bound) and g = 1 / d^2; 0 when v is 0.
+inline double eval_weight(const bayes_stats& s, size_t i, const bayes_params& p, double v, double g) {
+  if (!(v > 0)) return 0;
+  if (!p.second_moment) return double(s.q2[i]) * v + double(s.q1[i]) * g;
+  double val = (double(s.q2[i]) * v + double(s.q1[i]) * g) * v + double(s.q0[i]) * g * g;
+  return std::sqrt(std::max(val, double(s.qc[i]) * v * v));
+}
 // Scales all statistics by gamma (animation: the prior regains weight).
-void decay_stats(bayes_stats& s, double gamma);
+void decay_stats(bayes_stats& s, double gamma, const bayes_params& p);
 
 // One pair's statistics accumulated within one image row (Welford).
 struct pair_accum {
@@ -51,11 +67,12 @@ struct bayes_row {
   void add(int pair, double z);
 };
 
-// Folds the rows, in order, into the statistics (Chan's parallel update).
-void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows);
+// Folds the rows, in order, into the statistics (Chan's parallel update) and refreshes the coefficients of
+// the pairs they touched.
+void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p);
 
-// Posterior sampling weight of one cluster: sqrt((1 - p0)(k^2 + h)) / d^2 (or the ablations), from its statistics
-// and the prior mean mu0 = scale * bound * d^2. Returns 0 when bound is 0.
+// Reference form of the weight (the conjugate posterior written out, in double): sqrt((1 - p0)(k^2 + h)) / d^2
+// (or the ablations) from a pair's statistics and mu0 = scale * bound * d^2. eval_weight must agree with it.
 double posterior_weight(const bayes_params& p, double bound, double scale, double d, double n0, double n1,
                         double mean, double m2);
 

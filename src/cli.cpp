@@ -45,6 +45,9 @@ struct render_options {
   std::string reference;
   std::string log;
   bool quiet = false;
+  region_params regions;
+  bayes_params bayes;
+  std::string bayes_pmf = "second-moment";
 };
 
 // Options of `diff`.
@@ -80,6 +83,9 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.seed = o.has_seed ? o.seed : desc.seed;
   p.threads = o.threads;
   p.sampler.kind = kind;
+  p.sampler.regions = o.regions;
+  p.sampler.bayes = o.bayes;
+  p.sampler.bayes.second_moment = o.bayes_pmf == "second-moment";
   p.progress = !o.quiet && stderr_is_terminal();
   return p;
 }
@@ -164,6 +170,37 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--reference", o.reference, "Reference .exr/.pfm of the same size: error after every pass");
   r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse");
   r->add_flag("--quiet", o.quiet, "No progress bar or summary");
+  // Regions, cuts and the ablation switches of the adaptive samplers.
+  const char* grp = "Regions and light cuts (bound, bayes)";
+  r->add_option("--grid", o.regions.grid, "Region cells along the shortest axis of the scene bounds (default 64)")
+      ->check(CLI::Range(1, 100000))->group(grp);
+  r->add_option("--max-cut", o.regions.max_cut, "Light clusters per region (default 64, at most 1024)")
+      ->check(CLI::Range(1, 1024))->group(grp);
+  r->add_option("--cut-coherence", o.regions.coherence,
+                "Keep a light cluster whole when its radius / gap to the region <= this (default 0.25; 0 = off)")
+      ->check(CLI::Range(0.0, 100.0))->group(grp);
+  r->add_option("--region-budget", o.regions.max_pairs,
+                "Most (region, cluster) pairs before coarser regions serve (default 8388608)")
+      ->check(CLI::Range(int64_t(1), int64_t(1) << 40))->group(grp);
+  const char* bg = "Bayesian sampler (bayes): prior strengths and ablations";
+  r->add_option("--bayes-pmf", o.bayes_pmf, "second-moment (the paper) or mean (ablation: PMF from the mean only)")
+      ->check(CLI::IsMember({"second-moment", "mean"}))->group(bg);
+  r->add_flag_callback("--bayes-no-regression", [&o] { o.bayes.distance_regression = false; },
+                       "Ablation: no 1/d^2 distance regression (z = Y)")->group(bg);
+  r->add_flag_callback("--bayes-naive", [&o] { o.bayes.prior = false; },
+                       "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method)")->group(bg);
+  r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the bound PMF, in [0, 1]")
+      ->check(CLI::Range(0.0, 1.0))->group(bg);
+  r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (> 0)")
+      ->check(CLI::PositiveNumber)->group(bg);
+  r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (> 0)")
+      ->check(CLI::PositiveNumber)->group(bg);
+  r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (> 0)")
+      ->check(CLI::PositiveNumber)->group(bg);
+  r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1)")
+      ->check(CLI::Range(1.000001, 1e9))->group(bg);
+  r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0)")
+      ->check(CLI::PositiveNumber)->group(bg);
 }
 
 }  // namespace

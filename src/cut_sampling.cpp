@@ -24,11 +24,11 @@ void finish_cdf(cut_context& ctx, const double* w) {
     for (int j = 0; j < ctx.count; j++) ctx.cdf[j + 1] = 0;
     return;
   }
-  double acc = 0;
+  double acc = 0, inv = 1 / total;
   int last = -1;
   for (int j = 0; j < ctx.count; j++) {
     acc += w[j];
-    ctx.cdf[j + 1] = float(acc / total);
+    ctx.cdf[j + 1] = float(acc * inv);
     if (w[j] > 0) last = j;
   }
   for (int j = last; j < ctx.count; j++) ctx.cdf[j + 1] = 1.0f;

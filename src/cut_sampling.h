@@ -33,12 +33,20 @@ struct cut_context {
 // Fills the point and region part of a context.
 void locate_region(cut_context& ctx, const region_state& regions, const shade_point& sp);
 
-// Bound-based weight of cluster `node` (a tree node or sun_cluster) at (p, n): its importance.
+// Bound-based weight of cluster `node` (a tree node or sun_cluster) at (p, n): its importance, as a
+// distance-free numerator and inv_d2 = 1 / d^2 of the regression distance (1 for the sun).
+inline float cluster_bound_parts(const light_tree_data& tree, const light_data& lights, int node, vec3f p, vec3f n,
+                                 float sun_sin, float sun_cos, float& inv_d2) {
+  if (node == sun_cluster) {
+    inv_d2 = 1;
+    return luminance(lights.sun_irradiance) * receiver_cos_bound(n, lights.sun_dir, sun_sin, sun_cos);
+  }
+  return node_importance_parts(tree, node, p, n, inv_d2);
+}
 inline float cluster_bound(const light_tree_data& tree, const light_data& lights, int node, vec3f p, vec3f n,
                            float sun_sin, float sun_cos) {
-  if (node == sun_cluster)
-    return luminance(lights.sun_irradiance) * receiver_cos_bound(n, lights.sun_dir, sun_sin, sun_cos);
-  return node_importance(tree, node, p, n);
+  float inv_d2;
+  return cluster_bound_parts(tree, lights, node, p, n, sun_sin, sun_cos, inv_d2) * inv_d2;
 }
 // Distance used by the regression for a cluster: to its box centre, clamped below by its radius (sun: 1).
 inline float cluster_distance(const light_tree_data& tree, int node, vec3f p) {

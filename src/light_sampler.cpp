@@ -101,7 +101,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.sun_cos = sun_cos;
       s.params = params.bayes;
       s.regions = make_regions(params, in, tree);
-      resize_stats(s.stats, s.regions.pairs);
+      resize_stats(s.stats, s.regions.pairs, s.params);
       return s;
     }
     default: break;
@@ -112,7 +112,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
 size_t sampler_memory_bytes(const light_sampler& s) {
   if (auto* b = std::get_if<bound_sampler>(&s)) return region_memory_bytes(b->regions);
   if (auto* b = std::get_if<bayes_sampler>(&s))
-    return region_memory_bytes(b->regions) + b->stats.n0.size() * 4 * sizeof(double);
+    return region_memory_bytes(b->regions) + b->stats.n0.size() * (4 * sizeof(double) + 4 * sizeof(float));
   return 0;
 }
 

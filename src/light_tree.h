@@ -73,11 +73,13 @@ inline float receiver_cos_bound(vec3f n, vec3f w_to, float sin_b, float cos_b) {
 // Importance of a node for a shading point (p, n) — an estimate of the unoccluded irradiance it can give:
 // intensity * emitter cos bound * receiver cos bound / d^2, d the distance to the box centre clamped below by
 // the box radius (Conty-Kulla / pbrt-v4 style). Zero only when the node provably cannot light the point.
-inline float node_importance(const light_tree_data& t, int node, vec3f p, vec3f n) {
+// Returned in two parts: the distance-free numerator, and inv_d2 = 1 / d^2 (the regression's distance term).
+inline float node_importance_parts(const light_tree_data& t, int node, vec3f p, vec3f n, float& inv_d2) {
   size_t i = size_t(node);
   vec3f to_p = p - t.center[i];
   float d2 = length_sq(to_p);
   float r = t.radius[i];
+  inv_d2 = 1 / std::max(d2, r * r);
   float d = std::sqrt(d2);
   // Angle subtended by the node's bounding sphere seen from p (theta_b = pi inside it).
   float sin_b = 0, cos_b = -1;
@@ -89,8 +91,12 @@ inline float node_importance(const light_tree_data& t, int node, vec3f p, vec3f 
   float ce = node_emitter_cos_bound(t, node, w, sin_b, cos_b);
   if (ce == 0) return 0;
   float cr = receiver_cos_bound(n, -w, sin_b, cos_b);
-  if (cr == 0) return 0;
-  return t.intensity[i] * ce * cr / std::max(d2, r * r);
+  return t.intensity[i] * ce * cr;
+}
+inline float node_importance(const light_tree_data& t, int node, vec3f p, vec3f n) {
+  float inv_d2;
+  float num = node_importance_parts(t, node, p, n, inv_d2);
+  return num * inv_d2;
 }
 
 // Conservative bound of a node's unoccluded irradiance anywhere in the box [lo, hi] (any receiver normal):

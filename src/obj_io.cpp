@@ -1,6 +1,7 @@
-// obj_io: turns a validated OBJ (obj_validate) into mesh_data. tinyobjloader parses the clean text (numbers,
-// index triples, negative indices, usemtl ids); we triangulate, drop degenerate triangles, compact the vertex
-// arrays and load each distinct texture once.
+// obj_io: turns a validated OBJ (obj_validate) into mesh_data. tinyobjloader parses the clean text (index
+// triples, negative indices, usemtl ids; its counts are checked against the validator's, whose correctly
+// rounded numbers we keep); we triangulate, drop degenerate triangles, compact the vertex arrays and load each
+// distinct texture once.
 // Invariants: triangles keep the polygon's winding and come in file order; arrays hold only referenced
 // elements, in file order; nothing iterates a hash or pointer order; geometry tests are float maths.
 #include "obj_io.h"
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <istream>
 #include <map>
 #include <new>
 #include <stdexcept>
@@ -201,20 +203,37 @@ static std::vector<size_t> compact_refs(std::vector<int>& refs, size_t count) {
   return kept;
 }
 
-// Parses the clean text with tinyobjloader and checks it read what the validator saw.
-static tinyobj::ObjReader parse_clean(const std::string& path, const obj_clean_data& clean) {
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = false;  // its ear clipping loses or flips triangles of concave polygons: we triangulate
-  config.vertex_color = false;
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromString(clean.obj_text, clean.mtl_text, config))
-    throw std::logic_error(path + ": tinyobjloader rejected validated text: " + reader.Error());
-  const auto& a = reader.GetAttrib();
+// What tinyobjloader parsed from the clean text.
+struct tinyobj_result {
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+};
+
+// A read-only stream buffer over a string, so that tinyobjloader reads the clean text without a copy.
+struct string_view_buf : std::streambuf {
+  explicit string_view_buf(const std::string& s) {
+    char* p = const_cast<char*>(s.data());  // get area only: never written through
+    setg(p, p, p + s.size());
+  }
+};
+
+// Parses the clean text with tinyobjloader (LoadObj, the parser behind ObjReader) and checks it read what the
+// validator saw.
+static tinyobj_result parse_clean(const std::string& path, const obj_clean_data& clean) {
+  string_view_buf obj_buf(clean.obj_text), mtl_buf(clean.mtl_text);
+  std::istream obj_in(&obj_buf), mtl_in(&mtl_buf);
+  tinyobj::MaterialStreamReader mtl_reader(mtl_in);
+  tinyobj_result r;
+  std::vector<tinyobj::material_t> materials;  // names u<k> only: the validator parsed the real MTL files
+  std::string warn, err;
+  // triangulate = false: its ear clipping loses or flips triangles of concave polygons, so we triangulate.
+  if (!tinyobj::LoadObj(&r.attrib, &r.shapes, &materials, &warn, &err, &obj_in, &mtl_reader, false, false))
+    throw std::logic_error(path + ": tinyobjloader rejected validated text: " + err);
+  const auto& a = r.attrib;
   size_t faces = 0, corners = 0;
-  bool same = a.vertices.size() == 3 * size_t(clean.vertex_count) &&
-              a.normals.size() == 3 * size_t(clean.normal_count) &&
-              a.texcoords.size() == 2 * size_t(clean.texcoord_count) && reader.GetShapes().size() <= 1;
-  for (const auto& s : reader.GetShapes()) {
+  bool same = a.vertices.size() == 3 * clean.positions.size() && a.normals.size() == 3 * clean.normals.size() &&
+              a.texcoords.size() == 2 * clean.texcoords.size() && r.shapes.size() <= 1;
+  for (const auto& s : r.shapes) {
     for (size_t f = 0; same && f < s.mesh.num_face_vertices.size(); f++, faces++) {
       same = faces < clean.face_sizes.size() && s.mesh.num_face_vertices[f] == (clean.face_sizes[faces] & 0xff) &&
              s.mesh.material_ids[f] == clean.face_materials[faces];
@@ -224,17 +243,15 @@ static tinyobj::ObjReader parse_clean(const std::string& path, const obj_clean_d
   }
   if (!same || faces != clean.face_sizes.size())
     throw std::logic_error(path + ": tinyobjloader read the validated OBJ differently (loader bug)");
-  return reader;
+  return r;
 }
 
 // Builds the mesh from the parsed OBJ: triangles, compacted vertex arrays, materials and textures.
-static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean, const tinyobj::ObjReader& reader) {
-  const auto& a = reader.GetAttrib();
-  auto position = [&](size_t i) { return vec3f{a.vertices[3 * i], a.vertices[3 * i + 1], a.vertices[3 * i + 2]}; };
-  std::vector<vec3f> normals(size_t(clean.normal_count));
+static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean, const tinyobj_result& parsed) {
+  auto position = [&](size_t i) { return clean.positions[i]; };
+  std::vector<vec3f> normals(clean.normals.size());
   std::vector<char> normal_ok(normals.size());
-  for (size_t i = 0; i < normals.size(); i++)
-    normal_ok[i] = unit_normal({a.normals[3 * i], a.normals[3 * i + 1], a.normals[3 * i + 2]}, normals[i]);
+  for (size_t i = 0; i < normals.size(); i++) normal_ok[i] = unit_normal(clean.normals[i], normals[i]);
 
   mesh_data mesh;
   triangulate_state st;
@@ -242,7 +259,7 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   std::vector<int> local;
   int default_material = int(clean.materials.size());
   size_t face = 0;  // faces in file order across shapes (there is at most one shape)
-  for (const auto& s : reader.GetShapes()) {
+  for (const auto& s : parsed.shapes) {
     size_t next_index = 0;
     for (size_t f = 0; f < s.mesh.material_ids.size(); f++, face++) {
       int n = clean.face_sizes[face];
@@ -280,12 +297,10 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
                                             : std::string()));
 
   // Compact each vertex array to the referenced elements, keeping file order.
-  for (size_t i : compact_refs(mesh.tri_positions, size_t(clean.vertex_count))) mesh.positions.push_back(position(i));
+  for (size_t i : compact_refs(mesh.tri_positions, clean.positions.size())) mesh.positions.push_back(position(i));
   for (size_t i : compact_refs(mesh.tri_normals, normals.size())) mesh.normals.push_back(normals[i]);
-  for (size_t i : compact_refs(mesh.tri_texcoords, size_t(clean.texcoord_count))) {
-    float u = a.texcoords[2 * i], v = a.texcoords[2 * i + 1];
-    mesh.texcoords.push_back({std::isfinite(u) ? u : 0.0f, std::isfinite(v) ? v : 0.0f});
-  }
+  for (size_t i : compact_refs(mesh.tri_texcoords, clean.texcoords.size()))
+    mesh.texcoords.push_back(clean.texcoords[i]);
 
   // Materials in order of first usemtl, then the default one if some face had none; textures once per path.
   std::map<std::string, int> loaded;
@@ -307,9 +322,9 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
 mesh_data load_obj(const std::string& path) {
   try {
     obj_clean_data clean = validate_obj(path);
-    tinyobj::ObjReader reader = parse_clean(path, clean);
+    tinyobj_result parsed = parse_clean(path, clean);
     clean.obj_text = std::string();
-    return build_mesh(path, clean, reader);
+    return build_mesh(path, clean, parsed);
   } catch (const std::bad_alloc&) {
     throw input_error(path, "out of memory while loading (input too large?)");
   } catch (const std::length_error&) {

@@ -17,7 +17,7 @@ namespace bl {
 // the default below.
 struct material_data {
   std::string name;
-  vec3f kd = {0.8f, 0.8f, 0.8f};  // Kd diffuse albedo
+  vec3f kd = {0.8f, 0.8f, 0.8f};  // Kd diffuse albedo (multiplies kd_texture; 1 when map_Kd comes without Kd)
   vec3f ks = {0, 0, 0};           // Ks specular albedo of the normalized Phong lobe
   float ns = 1;                   // Ns Phong exponent (>= 0)
   vec3f ke = {0, 0, 0};           // Ke emitted radiance (non-zero: the triangle is an area light)

@@ -176,14 +176,14 @@ static void check_index(string_view t, int count, const char* what, const text_p
 // Checks one face corner: v, v/vt, v//vn or v/vt/vn.
 static void check_corner(string_view c, const obj_clean_data& d, const text_pos& pos) {
   size_t s1 = c.find('/');
-  if (s1 == string_view::npos) return check_index(c, d.vertex_count, "vertex", pos);
+  if (s1 == string_view::npos) return check_index(c, int(d.positions.size()), "vertex", pos);
   size_t s2 = c.find('/', s1 + 1);
   if (s2 != string_view::npos && c.find('/', s2 + 1) != string_view::npos)
     fail(pos, "malformed face corner " + quote(c) + " (expected v, v/vt, v//vn or v/vt/vn)");
-  check_index(c.substr(0, s1), d.vertex_count, "vertex", pos);
+  check_index(c.substr(0, s1), int(d.positions.size()), "vertex", pos);
   string_view vt = c.substr(s1 + 1, s2 == string_view::npos ? string_view::npos : s2 - s1 - 1);
-  if (s2 == string_view::npos || !vt.empty()) check_index(vt, d.texcoord_count, "texcoord", pos);
-  if (s2 != string_view::npos) check_index(c.substr(s2 + 1), d.normal_count, "normal", pos);
+  if (s2 == string_view::npos || !vt.empty()) check_index(vt, int(d.texcoords.size()), "texcoord", pos);
+  if (s2 != string_view::npos) check_index(c.substr(s2 + 1), int(d.normals.size()), "normal", pos);
 }
 
 // Counts unrecognised statements of one file and reports them once.
@@ -276,6 +276,8 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
   string_view line;
   unknown_log unknown;
   mtl_material_data* cur = nullptr;
+  size_t first = out.size();
+  std::vector<char> has_kd;  // per material of this file: a Kd statement was seen
   while (lines.next(line)) {
     text_pos pos{path, lines.line};
     tokenize(line, pos, t);
@@ -286,6 +288,7 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       out.emplace_back();
       cur = &out.back();
       cur->material.name = join_from(t, 1);
+      has_kd.push_back(0);
       cur->mtl_path = path;
       continue;
     }
@@ -305,7 +308,7 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       if (k == "map_d") cur->alpha_map = file, cur->alpha_map_line = int(std::min<size_t>(lines.line, INT_MAX));
     } else if (k == "Kd" || k == "Ks" || k == "Ke" || k == "Ka" || k == "Tf" || k == "Kt") {
       vec3f c = colour_at(t, pos);
-      if (k == "Kd") m.kd = c;
+      if (k == "Kd") m.kd = c, has_kd.back() = 1;
       if (k == "Ks") m.ks = c;
       if (k == "Ke") m.ke = c;
     } else {
@@ -315,6 +318,9 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       if (k == "Ns") m.ns = v;
     }
   }
+  // A map_Kd without Kd shows the texture as it is (Kd multiplies the texture, as the MTL format says).
+  for (size_t i = first; i < out.size(); i++)
+    if (!out[i].kd_map.empty() && !has_kd[i - first]) out[i].material.kd = {1, 1, 1};
   unknown.report(path);
 }
 
@@ -377,10 +383,16 @@ obj_clean_data validate_obj(const std::string& path) {
                        : k == "vn" ? " takes 3 numbers"
                                    : " takes 1 to 3 numbers") +
                       ", got " + std::to_string(args));
-      for (size_t i = 1; i <= args; i++) number_at(t[i], pos);
-      int& count = k == "v" ? d.vertex_count : k == "vn" ? d.normal_count : d.texcoord_count;
-      if (count == INT_MAX - 1) fail(pos, "too many " + std::string(k) + " statements");
-      count++;
+      float x[3] = {0, 0, 0};
+      for (size_t i = 1; i <= args; i++) {
+        float v = number_at(t[i], pos);
+        if (i <= 3) x[i - 1] = v;
+      }
+      size_t count = k == "v" ? d.positions.size() : k == "vn" ? d.normals.size() : d.texcoords.size();
+      if (count >= size_t(INT_MAX - 1)) fail(pos, "too many " + std::string(k) + " statements");
+      if (k == "v") d.positions.push_back({x[0], x[1], x[2]});
+      if (k == "vn") d.normals.push_back({x[0], x[1], x[2]});
+      if (k == "vt") d.texcoords.push_back({x[0], x[1]});
       size_t keep = k == "vt" ? std::min<size_t>(args, 2) : 3;
       body += k;
       for (size_t i = 1; i <= keep; i++) (body += ' ') += t[i];

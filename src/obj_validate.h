@@ -28,7 +28,10 @@ struct obj_clean_data {
   std::vector<mtl_material_data> materials;  // used materials; k = order of first usemtl in the OBJ
   std::vector<int> face_sizes;               // corners of each face, in file order
   std::vector<int> face_materials;           // k of each face, or invalid_id before any usemtl
-  int vertex_count = 0, normal_count = 0, texcoord_count = 0;
+  // v, vn and vt values as correctly rounded floats (strtof): tinyobjloader's own number parser uses double
+  // pow, whose last bit may differ between CPUs, so these, not its attrib, feed the mesh.
+  std::vector<vec3f> positions, normals;
+  std::vector<vec2f> texcoords;
 };
 
 // Longest accepted number token (real files write at most ~25 characters).

@@ -92,7 +92,7 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
       g.dims[l][a] = l == 2 ? 1 : std::max(1, std::min(max_cells_per_axis, int(std::ceil(ext[a] / g.cell[l])) + 1));
   std::vector<int> all;
   int leaves = (node_count(tree) + 1) / 2;
-  if (node_count(tree) > 0 && leaves <= params.max_cut) {
+  if (node_count(tree) > 0 && leaves <= std::min(params.max_cut, params.shared_cut_lights)) {
     // A handful of lights: one cut of all lights serves every region.
     s.shared_cut = true;
     for (int n = 0; n < node_count(tree); n++)
@@ -186,6 +186,16 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
   return added;
 }
 
+// Whether node's lights light every point of the box in nearly the same proportions (splitting it would
+// not change sampling much): its radius is small against its gap to the box and its normals agree.
+static bool coherent_node(const light_tree_data& tree, int node, const bbox3f& box, float coherence) {
+  constexpr float cos_30 = 0.8660254f;
+  size_t i = size_t(node);
+  if (tree.cos_o[i] < cos_30) return false;
+  float gap = length(center(box) - tree.center[i]) - 0.5f * diagonal(box) - tree.radius[i];
+  return gap > 0 && tree.radius[i] <= coherence * gap;
+}
+
 std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool has_sun, const region_params& p) {
   std::vector<int> cut;
   if (node_count(tree) > 0) {
@@ -198,7 +208,7 @@ std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool
     double total = root_bound;
     while (!heap.empty()) {
       entry top = heap.top();
-      if (is_leaf(tree, top.second)) {
+      if (is_leaf(tree, top.second) || coherent_node(tree, top.second, box, p.coherence)) {
         heap.pop();
         cut.push_back(top.second);
         continue;

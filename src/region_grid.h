@@ -20,6 +20,9 @@ struct region_params {
   int grid = 64;                   // fine cells along the shortest axis of the scene bounds
   int max_cut = 64;                // clusters per region (the sun, if any, comes on top)
   float cut_threshold = 0.005f;    // stop refining when every cluster bound < threshold * total
+  float coherence = 0.25f;         // keep a node whole when radius / gap to the region <= this and its
+                                   // normals lie within 30 degrees (its lights light the region alike)
+  int shared_cut_lights = 4;       // at most this many lights: one cut of all lights, no clustering
   int64_t max_pairs = int64_t(1) << 23;  // memory budget in (region, cluster) pairs
 };
 
@@ -73,7 +76,8 @@ int find_region(const region_state& s, uint64_t fine_key);
 int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys);
 
 // The light cut of a box: tree nodes sorted by id (then sun_cluster if has_sun), Lightcuts-style refinement of
-// conservative bounds; nodes that cannot light any point of the box are left out.
+// conservative bounds in order of decreasing bound, except that coherent nodes (small and far as seen from
+// the box, narrow normal cone) stay whole; nodes that cannot light any point of the box are left out.
 std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool has_sun, const region_params& p);
 
 // Bytes used by the region state (columns and table).

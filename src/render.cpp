@@ -186,6 +186,8 @@ render_result render(const scene_data& scene, const bvh_data& bvh, const light_d
   result.setup_seconds = seconds_since(t0);
   std::visit([&](auto& s) { render_with(in, s, params, result); }, sampler);
   result.sampler_bytes = sampler_memory_bytes(sampler);
+  if (auto* b = std::get_if<bound_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
+  if (auto* b = std::get_if<bayes_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
   return result;
 }
 

@@ -50,6 +50,8 @@ struct render_result {
   double seconds = 0;         // render wall time (passes and learning, not error computation)
   double setup_seconds = 0;   // light tree, regions (before the first pass; not in `seconds`)
   size_t sampler_bytes = 0;   // memory of the sampler's regions, cuts and statistics
+  int regions = 0;            // regions of a region-based sampler
+  int64_t pairs = 0;          // (region, cluster) pairs
   path_stats stats;
   std::vector<pass_record> log;
 };

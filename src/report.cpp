@@ -28,6 +28,11 @@ std::string render_summary(const render_result& r, const std::vector<std::string
                 r.seconds > 0 ? rays / r.seconds * 1e-6 : 0.0,
                 r.seconds > 0 ? double(st.nee_samples) / r.seconds * 1e-6 : 0.0);
   std::string s = buf;
+  if (r.regions > 0) {
+    std::snprintf(buf, sizeof buf, "; %d regions, %.1f clusters per region, %.1f MB sampler state", r.regions,
+                  double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));
+    s += buf;
+  }
   if (st.bad_samples > 0) s += "; " + std::to_string(st.bad_samples) + " non-finite samples discarded";
   if (r.spp > 0) {
     s += " -> ";

@@ -211,6 +211,8 @@ TEST_CASE("map_Kd and map_d are resolved beside the MTL and decoded once", "[obj
   CHECK(m.materials[0].alpha_texture == 0);
   CHECK(m.materials[1].kd_texture == 0);
   CHECK(m.materials[1].alpha_texture == invalid_id);
+  CHECK(m.materials[0].kd.x == 1.0f);  // map_Kd without Kd: the texture as it is
+  CHECK(m.materials[1].kd.x == 0.2f);  // Kd given: it multiplies the texture
   const texture_data& t = m.textures[0];
   CHECK(t.path == dir.path + "/mats/tex/a.png");
   REQUIRE(t.width == 2);

@@ -1,0 +1,492 @@
+// The light-sampler contract (light_sampler_types.h) checked for every available sampler kind, built by
+// make_light_sampler on a small scene with a few dozen emitters of very different power (some facing away from
+// everything), with and without a sun: at many shading points on the scene's surfaces the pmf sums to 1 (or 0
+// when no light can contribute) within 1e-5, sample() returns prob bitwise equal to pmf() (MIS needs it),
+// sampled frequencies match the pmf (chi-square, significance 1e-3 per test, 100k samples, fixed seeds), and
+// every light that can contribute has pmf > 0. The learning samplers are checked again after learning from
+// passes of real paths.
+#include "bvh.h"
+#include "integrator.h"
+#include "light_sampler.h"
+#include "lights.h"
+#include "render.h"
+#include "rng.h"
+#include "scene.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <memory>
+#include <sstream>
+#include <type_traits>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+constexpr double alpha = 1e-3;     // chi-square significance level of every frequency test here
+constexpr double sum_tol = 1e-5;   // tolerance of sum(pmf) = 1 (float cdfs and products of a few factors)
+constexpr int chi2_samples = 100000;
+
+float unif(pcg32& r) { return uint_to_unit(r()); }
+float log_uniform(pcg32& r, float lo, float hi) { return lo * std::pow(hi / lo, unif(r)); }
+vec3f random_unit(pcg32& r) {
+  float z = 1 - 2 * unif(r), phi = 2 * pi_f * unif(r);
+  float s = safe_sqrt(1 - z * z);
+  return {s * std::cos(phi), s * std::sin(phi), z};
+}
+vec3f random_in(pcg32& r, vec3f lo, vec3f hi) {
+  return {lo.x + (hi.x - lo.x) * unif(r), lo.y + (hi.y - lo.y) * unif(r), lo.z + (hi.z - lo.z) * unif(r)};
+}
+bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// The test scene, its acceleration structure and lights (heap-held: bvh_data and render_inputs point into it).
+struct test_scene {
+  scene_data scene;
+  bvh_data bvh;
+  light_data lights;
+  light_tree_data tree;
+  render_inputs in;
+};
+
+// A floor, a back wall and an occluding box, lit by 36 small emitters whose radiance spans 1e-3..1e4: most face
+// down (randomly tilted), a quarter face up (away from the floor: they light only the ceiling-less void), plus
+// optionally a sun. Emitters are partly reflective (shading points on them too).
+std::unique_ptr<test_scene> make_test_scene(bool sun, int image = 16) {
+  pcg32 rng(2024, 3);
+  mesh_builder b;
+  int floor = b.add_material({0.5f, 0.5f, 0.5f});
+  int wall = b.add_material({0.3f, 0.4f, 0.5f}, {0, 0, 0}, {0.2f, 0.2f, 0.2f}, 20);
+  b.add_quad({-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, floor);
+  b.add_quad({-10, 0, -6}, {10, 0, -6}, {10, 6, -6}, {-10, 6, -6}, wall);
+  b.add_box({-1, 0, -1}, {1, 1.5f, 1}, wall);
+  for (int i = 0; i < 36; i++) {
+    float le = log_uniform(rng, 1e-3f, 1e4f);
+    vec3f kd = i % 2 ? vec3f{0.2f, 0.2f, 0.2f} : vec3f{0, 0, 0};
+    int m = b.add_material(kd, {le, le * (0.5f + 0.5f * unif(rng)), le * (0.5f + 0.5f * unif(rng))});
+    vec3f c = random_in(rng, {-8, 1, -5}, {8, 5, 5});
+    float s = log_uniform(rng, 0.05f, 0.5f);
+    vec3f p0 = c, p1 = c + vec3f{s, s * (unif(rng) - 0.5f), 0}, p2 = c + vec3f{0, s * (unif(rng) - 0.5f), s};
+    if (i % 4 == 3) std::swap(p1, p2);  // faces up
+    b.add_triangle(p0, p1, p2, m);
+  }
+  auto t = std::make_unique<test_scene>();
+  camera_params cam;
+  cam.automatic = false;
+  cam.eye = {0, 6, 14};
+  cam.target = {0, 1, 0};
+  cam.fov_y_deg = 50;
+  sun_params sp;
+  if (sun) {
+    sp.enabled = true;
+    sp.direction = normalize(vec3f{0.3f, 1.0f, 0.2f});
+    sp.irradiance = {5, 5, 4};
+  }
+  t->scene = build_scene(std::move(b.mesh), cam, sp, false, 1.0f);
+  t->bvh = build_bvh(t->scene);
+  t->lights = build_lights(t->scene);
+  t->tree = build_light_tree(t->lights, t->scene);
+  t->in.scene = &t->scene;
+  t->in.bvh = &t->bvh;
+  t->in.lights = &t->lights;
+  t->in.camera = make_camera(t->scene.camera, image, image);
+  t->in.max_depth = 3;
+  t->in.seed = 5;
+  return t;
+}
+
+// Shading points on the scene's surfaces: first hits of camera rays and of random rays from random points
+// inside the scene's bounds; the normal faces the side the ray came from.
+std::vector<shade_point> shading_points(const test_scene& t, int count, uint64_t seed) {
+  pcg32 rng(seed, 5);
+  std::vector<shade_point> out;
+  bbox3f b = t.scene.bounds;
+  for (int tries = 0; int(out.size()) < count && tries < 100 * count; tries++) {
+    vec3f org, dir;
+    if (tries % 3 == 0) {
+      org = t.in.camera.eye;
+      dir = camera_ray_dir(t.in.camera, unif(rng) * float(t.in.camera.width), unif(rng) * float(t.in.camera.height));
+    } else {
+      org = random_in(rng, b.lo, b.hi);
+      dir = random_unit(rng);
+    }
+    hit_info h = intersect(t.bvh, org, dir);
+    if (h.tri == invalid_id) continue;
+    surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, dir);
+    const material_data& m = t.scene.mesh.materials[size_t(sp.material)];
+    out.push_back(shade_point{sp.p, sp.ng, luminance(m.kd) + luminance(m.ks), int(out.size()), 1 + tries % 2});
+  }
+  return out;
+}
+
+// Whether light l can contribute at (p, n): some point of it faces p from above p's tangent plane (the sun:
+// some direction of its disk lies above the plane). Configurations within 1e-5 (cosine) of grazing count as
+// "cannot": float rounding in the bounds is of order 1e-7 there and the contribution is at most 1e-5 relative.
+bool can_contribute(const test_scene& t, int l, vec3f p, vec3f n) {
+  constexpr double margin = 1e-5;
+  const light_data& L = t.lights;
+  if (l == L.sun) {
+    double sin_t = std::sqrt(double(L.sun_one_minus_cos) * (2 - double(L.sun_one_minus_cos)));
+    return double(dot(n, L.sun_dir)) > -sin_t + margin;
+  }
+  int tri = L.tri[size_t(l)];
+  vec3f p0 = t.scene.tri_p0[size_t(tri)];
+  vec3f v[3] = {p0, p0 + t.scene.tri_e1[size_t(tri)], p0 + t.scene.tri_e2[size_t(tri)]};
+  vec3f ng = t.scene.tri_ng[size_t(tri)];
+  vec3f c = (v[0] + v[1] + v[2]) * (1.0f / 3);
+  double dist = length(p - c);
+  double side = double(ng.x) * (p.x - c.x) + double(ng.y) * (p.y - c.y) + double(ng.z) * (p.z - c.z);
+  if (L.two_sided) side = std::fabs(side);
+  if (!(side > margin * dist)) return false;
+  for (vec3f q : v) {
+    double d = length(q - p);
+    double up = double(n.x) * (q.x - p.x) + double(n.y) * (q.y - p.y) + double(n.z) * (q.z - p.z);
+    if (up > margin * d) return true;
+  }
+  return false;
+}
+
+// Share of light l in the summed importance (leaf importances and the sun's) at (p, n), for messages.
+double relative_importance(const test_scene& t, int l, vec3f p, vec3f n) {
+  float sun_sin = 0, sun_cos = 1;
+  if (t.lights.sun != invalid_id) sun_half_angle(t.lights, sun_sin, sun_cos);
+  double total = sun_importance(t.lights, n, sun_sin, sun_cos), mine = 0;
+  if (l == t.lights.sun) mine = total;
+  for (int k = 0; k < t.lights.tri_count; k++) {
+    double imp = node_importance(t.tree, t.tree.leaf_of_light[size_t(k)], p, n);
+    total += imp;
+    if (k == l) mine = imp;
+  }
+  return total > 0 ? mine / total : 0;
+}
+
+// Sink handing NEE events to a learning sampler's row.
+template <class S>
+struct row_sink {
+  const S* sampler;
+  typename S::row_state* row;
+  template <class E>
+  void record(const E& e) {
+    sampler->record(*row, e);
+  }
+};
+
+// Renders `passes` passes of 1 spp with real paths, learning between passes (the render loop, single-threaded).
+template <class S>
+path_stats learn_passes(const render_inputs& in, S& s, int passes) {
+  path_stats st;
+  int w = in.camera.width, h = in.camera.height;
+  std::vector<typename S::row_state> rows(static_cast<size_t>(h));
+  for (int pass = 0; pass < passes; pass++) {
+    for (int y = 0; y < h; y++) {
+      rows[size_t(y)].clear();
+      row_sink<S> sink{&s, &rows[size_t(y)]};
+      for (int x = 0; x < w; x++) trace_path(in, s, x, y, uint64_t(pass), st, sink);
+    }
+    s.learn(rows);
+  }
+  return st;
+}
+
+// Counters of contract violations over many shading points.
+struct contract_report {
+  int points = 0, zero_sum = 0, bad_sum = 0, lossy_points = 0, bad_pmf = 0, starved = 0, prob_mismatch = 0, null_with_mass = 0,
+      bad_cluster_split = 0, chi2_tests = 0, chi2_failures = 0;
+  double worst_sum_error = 0, mean_deficit = 0, worst_deficit = 0;
+  std::string notes;  // the first few violations, for the failure message
+  void note(const std::string& s) {
+    if (std::count(notes.begin(), notes.end(), '\n') < 8) notes += s + "\n";
+  }
+};
+
+std::string sci(double v) {
+  std::ostringstream o;
+  o.precision(3);
+  o << std::scientific << v;
+  return o.str();
+}
+std::string fmt(vec3f v) {
+  std::ostringstream o;
+  o.precision(9);
+  o << "(" << v.x << " " << v.y << " " << v.z << ")";
+  return o.str();
+}
+
+// Checks the contract of sampler `s` at the given points; chi-square frequency tests at the first `chi2_points`.
+template <class S>
+contract_report check_contract(const test_scene& t, const S& s, const std::vector<shade_point>& pts, int chi2_points,
+                               uint64_t seed, bool may_lose_mass = false) {
+  contract_report rep;
+  int nl = t.lights.count;
+  pcg32 rng(seed, 9);
+  std::vector<float> pmf(static_cast<size_t>(nl));
+  auto ctx_ptr = std::make_unique<typename S::context>();  // cut contexts are large: keep them off the stack
+  typename S::context& ctx = *ctx_ptr;
+  for (size_t k = 0; k < pts.size(); k++) {
+    const shade_point& sp = pts[k];
+    s.prepare(ctx, sp);
+    rep.points++;
+    double sum = 0;
+    bool any = false;
+    for (int l = 0; l < nl; l++) {
+      pmf[size_t(l)] = s.pmf(ctx, l);
+      if (!(pmf[size_t(l)] >= 0) || !std::isfinite(pmf[size_t(l)]) || pmf[size_t(l)] > 1) rep.bad_pmf++;
+      sum += pmf[size_t(l)];
+      bool can = can_contribute(t, l, sp.p, sp.n);
+      any = any || can;
+      if (can && !(pmf[size_t(l)] > 0)) {
+        rep.starved++;
+        rep.note("starved light " + std::to_string(l) + " at point " + std::to_string(k) + " p " + fmt(sp.p) +
+                 " n " + fmt(sp.n) + ", its share of the summed importance " +
+                 sci(relative_importance(t, l, sp.p, sp.n)));
+      }
+    }
+    if (sum == 0) {
+      rep.zero_sum++;
+      if (any) {
+        rep.bad_sum++;
+        rep.note("pmf sums to 0 at point " + std::to_string(k) + " although some light can contribute");
+      }
+    } else if (may_lose_mass && sum < 1 - sum_tol) {
+      // Selection mass lost in subtrees whose children both turn out to be unable to light the point.
+      rep.lossy_points++;
+      rep.mean_deficit += 1 - sum;
+      rep.worst_deficit = std::max(rep.worst_deficit, 1 - sum);
+    } else {
+      rep.worst_sum_error = std::max(rep.worst_sum_error, std::fabs(sum - 1));
+      if (std::fabs(sum - 1) > sum_tol) {
+        rep.bad_sum++;
+        rep.note("pmf sums to " + std::to_string(sum) + " at point " + std::to_string(k) + " p " + fmt(sp.p) +
+                 " n " + fmt(sp.n));
+      }
+    }
+    // sample() against pmf(): bitwise equal probabilities; no failed sample while the pmf has full mass.
+    bool do_chi2 = int(k) < chi2_points;
+    int n_samples = do_chi2 ? chi2_samples : 200;
+    std::vector<double> obs(size_t(nl) + 1, 0.0);
+    for (int i = 0; i < n_samples; i++) {
+      float u1 = unif(rng), u2 = unif(rng);
+      light_choice c = s.sample(ctx, u1, u2);
+      if (c.light == invalid_id) {
+        obs[size_t(nl)] += 1;
+        if (std::fabs(sum - 1) <= sum_tol) rep.null_with_mass++;
+        continue;
+      }
+      obs[size_t(c.light)] += 1;
+      if (!same_bits(c.prob, pmf[size_t(c.light)]) || !(c.prob > 0)) {
+        rep.note("sample prob " + std::to_string(c.prob) + " pmf " + std::to_string(pmf[size_t(c.light)]) +
+                 " light " + std::to_string(c.light));
+        rep.prob_mismatch++;
+      }
+      if constexpr (std::is_same_v<typename S::context, cut_context>) {
+        // prob = P(cluster) * P(light | cluster), the split the learner's observations rely on.
+        if (c.cluster < 0 || c.cluster >= ctx.count || !same_bits(c.prob, cluster_pmf(ctx, c.cluster) * c.prob_in_cluster))
+          rep.bad_cluster_split++;
+      }
+    }
+    if (do_chi2) {
+      std::vector<double> exp(size_t(nl) + 1, 0.0);
+      for (int l = 0; l < nl; l++) exp[size_t(l)] = n_samples * double(pmf[size_t(l)]);
+      exp[size_t(nl)] = n_samples * std::max(0.0, 1 - sum);
+      if (sum == 0) exp[size_t(nl)] = n_samples;
+      double pv = chi2_pvalue(obs, exp);
+      rep.chi2_tests++;
+      if (!(pv > alpha)) {
+        rep.chi2_failures++;
+        rep.note("chi-square p-value " + std::to_string(pv) + " at point " + std::to_string(k));
+      }
+    }
+  }
+  if (rep.lossy_points > 0) rep.mean_deficit /= rep.lossy_points;
+  return rep;
+}
+
+void require_contract(const contract_report& r) {
+  INFO("points " << r.points << " (pmf sum 0 at " << r.zero_sum << "), worst |sum - 1| " << r.worst_sum_error
+                 << ", chi-square tests " << r.chi2_tests << ", points losing selection mass " << r.lossy_points
+                 << " (mean loss " << r.mean_deficit << ", worst " << r.worst_deficit << ")\n" << r.notes);
+  CHECK(r.points > 0);
+  CHECK(r.bad_pmf == 0);
+  CHECK(r.bad_sum == 0);
+  CHECK(r.starved == 0);
+  CHECK(r.prob_mismatch == 0);
+  CHECK(r.null_with_mass == 0);
+  CHECK(r.bad_cluster_split == 0);
+  CHECK(r.chi2_failures == 0);
+}
+
+const sampler_kind all_kinds[] = {sampler_kind::uniform, sampler_kind::power, sampler_kind::bvh, sampler_kind::bound,
+                                  sampler_kind::donikian, sampler_kind::bayes};
+
+// Region options of the cut-based samplers: the defaults, and small cuts on a coarse grid (clusters of many
+// lights, so the intensity descent inside clusters is exercised).
+sampler_params params_variant(sampler_kind kind, int variant) {
+  sampler_params p;
+  p.kind = kind;
+  if (variant == 1) {
+    p.regions.max_cut = 4;
+    p.regions.grid = 4;
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("every light sampler satisfies the sampling contract", "[samplers]") {
+  for (bool sun : {true, false}) {
+    auto t = make_test_scene(sun);
+    std::vector<shade_point> pts = shading_points(*t, 300, sun ? 1 : 2);
+    REQUIRE(pts.size() == 300);
+    for (sampler_kind kind : all_kinds) {
+      if (!sampler_available(kind)) continue;
+      for (int variant = 0; variant < 2; variant++) {
+        if (variant == 1 && (kind == sampler_kind::uniform || kind == sampler_kind::power || kind == sampler_kind::bvh))
+          continue;
+        INFO("sampler " << sampler_name(kind) << " sun " << sun << " variant " << variant);
+        light_sampler ls = make_light_sampler(params_variant(kind, variant), t->in, t->tree);
+        // The bvh sampler, like pbrt-v4's, gives up when both children of a node it descended into turn out to
+        // have zero importance: its pmf may sum to less than 1 (the rest is "no light", checked by chi-square).
+        bool lossy = kind == sampler_kind::bvh;
+        std::visit([&](const auto& s) { require_contract(check_contract(*t, s, pts, 4, 100 + variant, lossy)); }, ls);
+      }
+    }
+  }
+}
+
+TEST_CASE("learning samplers satisfy the sampling contract after learning", "[samplers]") {
+  for (bool sun : {true, false}) {
+    auto t = make_test_scene(sun);
+    std::vector<shade_point> pts = shading_points(*t, 300, sun ? 3 : 4);
+    for (sampler_kind kind : {sampler_kind::bound, sampler_kind::bayes}) {
+      for (int variant = 0; variant < 2; variant++) {
+        INFO("sampler " << sampler_name(kind) << " sun " << sun << " variant " << variant);
+        light_sampler ls = make_light_sampler(params_variant(kind, variant), t->in, t->tree);
+        std::visit(
+            [&](auto& s) {
+              using S = std::decay_t<decltype(s)>;
+              if constexpr (S::learns) {
+                path_stats st = learn_passes(t->in, s, 6);
+                CHECK(st.bad_samples == 0);
+                CHECK(st.nee_samples > 0);
+                require_contract(check_contract(*t, s, pts, 4, 200 + variant));
+              }
+            },
+            ls);
+        if (auto* b = std::get_if<bayes_sampler>(&ls)) {
+          // The statistics did learn something (and stayed finite).
+          double n = 0;
+          bool finite = true;
+          for (size_t i = 0; i < b->stats.n0.size(); i++) {
+            n += b->stats.n0[i] + b->stats.n1[i];
+            finite = finite && std::isfinite(b->stats.mean[i]) && std::isfinite(b->stats.m2[i]) &&
+                     std::isfinite(b->stats.q2[i]) && std::isfinite(b->stats.q1[i]) &&
+                     std::isfinite(b->stats.q0[i]) && std::isfinite(b->stats.qc[i]);
+          }
+          CHECK(n > 0);
+          CHECK(finite);
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("a scene without any light gives empty light selections", "[samplers]") {
+  mesh_builder b;
+  int floor = b.add_material({0.5f, 0.5f, 0.5f});
+  b.add_quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, floor);
+  camera_params cam;
+  cam.automatic = false;
+  cam.eye = {0, 2, 2};
+  cam.target = {0, 0, 0};
+  scene_data scene = build_scene(std::move(b.mesh), cam, sun_params{}, false, 1.0f);
+  bvh_data bvh = build_bvh(scene);
+  light_data lights = build_lights(scene);
+  light_tree_data tree = build_light_tree(lights, scene);
+  render_inputs in;
+  in.scene = &scene;
+  in.bvh = &bvh;
+  in.lights = &lights;
+  in.camera = make_camera(scene.camera, 4, 4);
+  for (sampler_kind kind : all_kinds) {
+    if (!sampler_available(kind)) continue;
+    INFO("sampler " << sampler_name(kind));
+    sampler_params p;
+    p.kind = kind;
+    light_sampler ls = make_light_sampler(p, in, tree);
+    std::visit(
+        [&](const auto& s) {
+          auto ctx = std::make_unique<typename std::decay_t<decltype(s)>::context>();
+          s.prepare(*ctx, shade_point{{0, 0, 0}, {0, 1, 0}, 0.5f, 0, 1});
+          light_choice c = s.sample(*ctx, 0.5f, 0.5f);
+          CHECK(c.light == invalid_id);
+          CHECK(c.prob == 0);
+        },
+        ls);
+  }
+}
+
+
+TEST_CASE("a light with a tiny share of the selection weight keeps a non zero pmf", "[samplers]") {
+  // Two bright lamps and five dim ones (radiance ratio 1e8), all facing the same floor point from similar
+  // distances. Every lamp can contribute, so every sampler must give every lamp pmf > 0 (unbiasedness), however
+  // small its share: a share below the float resolution of a cdf or of 1 - p must not round to exactly 0.
+  mesh_builder b;
+  int floor = b.add_material({0.5f, 0.5f, 0.5f});
+  int bright = b.add_material({0, 0, 0}, {1e7f, 1e7f, 1e7f});
+  int dim = b.add_material({0, 0, 0}, {0.1f, 0.1f, 0.1f});
+  b.add_quad({-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, floor);
+  auto lamp = [&](float x, float z, int m) {  // a 0.2 x 0.2 quad at height 2 facing down
+    b.add_quad({x, 2, z}, {x + 0.2f, 2, z}, {x + 0.2f, 2, z + 0.2f}, {x, 2, z + 0.2f}, m);
+  };
+  lamp(-3, 0, dim);
+  lamp(-1.5f, 0, dim);
+  lamp(0, 0, bright);
+  lamp(1.5f, 0, dim);
+  lamp(3, 0, dim);
+  lamp(0, 1.5f, dim);
+  lamp(0, -1.5f, bright);
+  auto t = std::make_unique<test_scene>();
+  camera_params cam;
+  cam.automatic = false;
+  cam.eye = {0, 5, 5};
+  cam.target = {0, 0, 0};
+  t->scene = build_scene(std::move(b.mesh), cam, sun_params{}, false, 1.0f);
+  t->bvh = build_bvh(t->scene);
+  t->lights = build_lights(t->scene);
+  t->tree = build_light_tree(t->lights, t->scene);
+  t->in.scene = &t->scene;
+  t->in.bvh = &t->bvh;
+  t->in.lights = &t->lights;
+  t->in.camera = make_camera(t->scene.camera, 8, 8);
+  std::vector<shade_point> pts;
+  for (float x : {-1.0f, 0.0f, 0.7f})
+    for (float z : {-0.5f, 0.3f}) pts.push_back(shade_point{{x, 0, z}, {0, 1, 0}, 0.5f, 0, 1});
+  for (sampler_kind kind : all_kinds) {
+    if (!sampler_available(kind)) continue;
+    INFO("sampler " << sampler_name(kind));
+    sampler_params p;
+    p.kind = kind;
+    light_sampler ls = make_light_sampler(p, t->in, t->tree);
+    std::visit(
+        [&](const auto& s) {
+          auto ctx = std::make_unique<typename std::decay_t<decltype(s)>::context>();
+          int starved = 0;
+          std::string which;
+          for (const shade_point& sp : pts) {
+            s.prepare(*ctx, sp);
+            for (int l = 0; l < t->lights.count; l++) {
+              REQUIRE(can_contribute(*t, l, sp.p, sp.n));
+              if (!(s.pmf(*ctx, l) > 0)) {
+                starved++;
+                which += " " + std::to_string(l);
+              }
+            }
+          }
+          INFO("lights with pmf 0 (over " << pts.size() << " points):" << which);
+          CHECK(starved == 0);
+        },
+        ls);
+  }
+}

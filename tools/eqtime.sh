@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Equal-time relMSE of several samplers on one scene against a cached reference.
+#   tools/eqtime.sh BIN SCENE_JSON SECONDS "uniform power bvh bound bayes" [extra render args]
+# The reference (bvh sampler, REF_SPP spp, its own seed) is cached in build/ref/ keyed by scene, size and depth.
+set -euo pipefail
+bin=$1; scene=$2; secs=$3; samplers=$4; shift 4
+extra="$*"
+W=${W:-320}; H=${H:-240}; REF_SPP=${REF_SPP:-1024}; REF_SAMPLER=${REF_SAMPLER:-bvh}
+dir=$(dirname "$bin")/ref; mkdir -p "$dir"
+key=$(echo "$scene $W $H $REF_SPP $REF_SAMPLER $extra" | md5sum | cut -c1-12)
+ref="$dir/$(basename "$(dirname "$scene")")_$(basename "$scene" .json)_$key.exr"
+if [ ! -f "$ref" ]; then
+  echo "reference: $REF_SAMPLER $REF_SPP spp -> $ref" >&2
+  "$bin" render "$scene" --sampler "$REF_SAMPLER" --spp "$REF_SPP" --seed 987654321 --width "$W" --height "$H" $extra -o "$ref" --quiet
+fi
+tmp=$(mktemp -d)
+for s in $samplers; do
+  "$bin" render "$scene" --sampler "$s" --time "$secs" --width "$W" --height "$H" $extra --reference "$ref" \
+    --log "$tmp/$s.csv" -o "$tmp/$s.exr" --quiet
+  tail -n 1 "$tmp/$s.csv" | awk -F, -v s="$s" '{printf "%-8s spp %5d  %6.2fs  relmse %.6g\n", s, $3, $4, $5}'
+done
+rm -rf "$tmp"
