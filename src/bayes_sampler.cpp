@@ -20,7 +20,11 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
     float inv_d2;
     float num = cluster_bound_parts(*tree, *lights, ctx.nodes[j], sp.p, sp.n, sun_sin, sun_cos, inv_d2);
     double bound = double(num) * inv_d2;
-    w[j] = eval_weight(stats, base + size_t(j), params, scale * bound, params.distance_regression ? inv_d2 : 1.0);
+    size_t i = base + size_t(j);
+    int up = regions.pair_parent[i];
+    double g = params.distance_regression ? inv_d2 : 1.0;
+    w[j] = up != invalid_id && params.hierarchy > 0 ? eval_weight_blend(stats, i, size_t(up), params, scale * bound, g)
+                                                    : eval_weight(stats, i, params, scale * bound, g);
     b[j] = bound;
     sum_w += w[j];
     sum_b += b[j];
@@ -42,7 +46,10 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
     double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
     z *= d * d;
   }
-  row.add(regions.pair_offset[size_t(ctx.region)] + j, z);
+  size_t i = size_t(regions.pair_offset[size_t(ctx.region)] + j);
+  row.add(int(i), z);
+  int up = regions.pair_parent[i];
+  if (up != invalid_id && params.hierarchy > 0) row.add(up, z);
 }
 
 void bayes_sampler::learn(std::vector<row_state>& rows) {

@@ -18,6 +18,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   s.q1.resize(n);
   s.q0.resize(n);
   s.qc.resize(n);
+  s.own.resize(n);
   if (n > old) {
     // All empty pairs share the prior-only coefficients.
     update_coeffs(s, old, p);
@@ -26,6 +27,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
       s.q1[i] = s.q1[old];
       s.q0[i] = s.q0[old];
       s.qc[i] = s.qc[old];
+      s.own[i] = s.own[old];
     }
   }
 }
@@ -70,6 +72,8 @@ void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
       qc = p1 * c;
     }
   }
+  double n = n0 + n1;
+  s.own[i] = p.hierarchy > 0 ? float(n / (n + p.hierarchy)) : 1.0f;
   s.q2[i] = float(q2);
   s.q1[i] = float(q1);
   s.q0[i] = float(q0);

@@ -26,6 +26,8 @@ struct bayes_params {
   bool distance_regression = true;  // false: z = Y, no 1/d^2 model (ablation)
   bool prior = true;             // false: plug-in sample moments, the naive adaptive method (ablation)
   double decay = 1;              // statistics scale per animation frame (1: keep everything)
+  double hierarchy = 8;          // a fine pair leans on its coarse parent's posterior as if it were this many
+                                 // samples: weight n / (n + hierarchy) on its own (0: no hierarchy)
 };
 
 // Statistics columns, one entry per (region, cluster) pair, with the posterior folded into per-pair
@@ -36,6 +38,7 @@ struct bayes_params {
 struct bayes_stats {
   std::vector<double> n0, n1, mean, m2;
   std::vector<float> q2, q1, q0, qc;
+  std::vector<float> own;  // n / (n + hierarchy): weight of the pair's own posterior against its parent's
 };
 
 // Grows the columns to `pairs` entries (new pairs start empty, with prior-only coefficients).
@@ -48,6 +51,17 @@ inline double eval_weight(const bayes_stats& s, size_t i, const bayes_params& p,
   if (!p.second_moment) return double(s.q2[i]) * v + double(s.q1[i]) * g;
   double val = (double(s.q2[i]) * v + double(s.q1[i]) * g) * v + double(s.q0[i]) * g * g;
   return std::sqrt(std::max(val, double(s.qc[i]) * v * v));
+}
+// Weight of fine pair i shrunk toward its coarse parent pair `up`: the predicted second moments (quadratics
+// in v and g) are blended with weight own[i] on the fine pair's, which grows with the fine pair's samples.
+inline double eval_weight_blend(const bayes_stats& s, size_t i, size_t up, const bayes_params& p, double v,
+                                double g) {
+  if (!(v > 0)) return 0;
+  double a = s.own[i], b = 1 - a;
+  double q2 = a * s.q2[i] + b * s.q2[up], q1 = a * s.q1[i] + b * s.q1[up];
+  if (!p.second_moment) return q2 * v + q1 * g;
+  double q0 = a * s.q0[i] + b * s.q0[up], qc = a * s.qc[i] + b * s.qc[up];
+  return std::sqrt(std::max((q2 * v + q1 * g) * v + q0 * g * g, qc * v * v));
 }
 // Scales all statistics by gamma (animation: the prior regains weight).
 void decay_stats(bayes_stats& s, double gamma, const bayes_params& p);

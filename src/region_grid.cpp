@@ -41,10 +41,12 @@ void reserve_table(region_state& s, size_t regions) {
   for (size_t r = 0; r < s.key.size(); r++) table_insert(s, s.key[r], int(r));
 }
 
-// Appends a region with the given cut (or the shared cut 0).
-int append_region(region_state& s, uint64_t key, const std::vector<int>* cut) {
+// Appends a region with the given cut (or the shared cut 0) under `parent` (or invalid_id), linking each of
+// its pairs to the parent's pair of the same cluster (cuts are sorted, so one merge walk finds them).
+int append_region(region_state& s, uint64_t key, const std::vector<int>* cut, int parent) {
   int id = int(s.key.size());
   s.key.push_back(key);
+  s.parent.push_back(parent);
   if (cut) {
     s.cut_offset.push_back(int(s.cut_nodes.size()));
     s.cut_size.push_back(int(cut->size()));
@@ -54,11 +56,30 @@ int append_region(region_state& s, uint64_t key, const std::vector<int>* cut) {
     s.cut_size.push_back(s.cut_size.empty() ? 0 : s.cut_size[0]);
   }
   s.pair_offset.push_back(int(s.pairs));
-  s.pairs += s.cut_size.back();
+  int n = s.cut_size.back();
+  s.pairs += n;
+  const int* mine = s.cut_nodes.data() + s.cut_offset.back();
+  for (int j = 0; j < n; j++) s.pair_parent.push_back(invalid_id);
+  if (parent != invalid_id) {
+    const int* theirs = s.cut_nodes.data() + s.cut_offset[size_t(parent)];
+    int m = s.cut_size[size_t(parent)];
+    int* links = s.pair_parent.data() + s.pair_offset.back();
+    // Both cuts hold ascending node ids, then possibly sun_cluster (-2) last.
+    for (int j = 0, k = 0; j < n; j++) {
+      if (mine[j] == sun_cluster) {
+        if (m > 0 && theirs[m - 1] == sun_cluster) links[j] = s.pair_offset[size_t(parent)] + m - 1;
+        continue;
+      }
+      while (k < m && theirs[k] != sun_cluster && theirs[k] < mine[j]) k++;
+      if (k < m && theirs[k] == mine[j]) links[j] = s.pair_offset[size_t(parent)] + k;
+    }
+  }
   reserve_table(s, s.key.size());
   table_insert(s, key, id);
   return id;
 }
+
+
 
 // Bounds are evaluated over the cell grown by a small margin, so points that round onto a neighbouring cell
 // are still covered by the conservative bound.
@@ -100,10 +121,10 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
     if (has_sun) all.push_back(sun_cluster);
   }
   uint64_t root_key = make_key(2, 0, 0, 0);
-  if (s.shared_cut) append_region(s, root_key, &all);
+  if (s.shared_cut) append_region(s, root_key, &all, invalid_id);
   else {
     std::vector<int> cut = compute_light_cut(tree, padded(b), has_sun, params);
-    append_region(s, root_key, &cut);
+    append_region(s, root_key, &cut, invalid_id);
   }
   s.root = 0;
   return s;
@@ -154,33 +175,28 @@ int find_region(const region_state& s, uint64_t fine_key) {
   return r != invalid_id ? r : s.root;
 }
 
+namespace {
+int make_region(region_state& s, const light_tree_data& tree, uint64_t key, int parent) {
+  if (s.shared_cut) return append_region(s, key, nullptr, parent);
+  std::vector<int> cut = compute_light_cut(tree, padded(region_box(s.grid, key)), s.has_sun, s.params);
+  return append_region(s, key, &cut, parent);
+}
+}  // namespace
+
 int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys) {
   int added = 0;
-  int64_t per_region = s.cut_size.empty() ? 1 : std::max(1, s.shared_cut ? s.cut_size[0] : s.params.max_cut + 1);
-  std::vector<uint64_t> coarse;
+  int64_t per_region = s.shared_cut ? std::max(1, s.cut_size[0]) : s.params.max_cut + 1;
   for (uint64_t key : fine_keys) {
     if (find_region_key(s, key) != invalid_id) continue;
-    if (s.pairs + per_region > s.params.max_pairs) {
-      coarse.push_back(parent_region_key(s.grid, key, 1));
-      continue;
+    // The coarse parent first (coarse regions are at most 1/512 of the fine ones; they ignore the budget).
+    uint64_t ckey = parent_region_key(s.grid, key, 1);
+    int parent = find_region_key(s, ckey);
+    if (parent == invalid_id) {
+      parent = make_region(s, tree, ckey, invalid_id);
+      added++;
     }
-    if (s.shared_cut) append_region(s, key, nullptr);
-    else {
-      std::vector<int> cut = compute_light_cut(tree, padded(region_box(s.grid, key)), s.has_sun, s.params);
-      append_region(s, key, &cut);
-    }
-    added++;
-  }
-  // Over budget: coarse cells serve the rest (they may exceed the budget by at most 1/512 of the fine cells).
-  std::sort(coarse.begin(), coarse.end());
-  coarse.erase(std::unique(coarse.begin(), coarse.end()), coarse.end());
-  for (uint64_t key : coarse) {
-    if (find_region_key(s, key) != invalid_id) continue;
-    if (s.shared_cut) append_region(s, key, nullptr);
-    else {
-      std::vector<int> cut = compute_light_cut(tree, padded(region_box(s.grid, key)), s.has_sun, s.params);
-      append_region(s, key, &cut);
-    }
+    if (s.pairs + per_region > s.params.max_pairs) continue;  // over budget: the coarse region serves
+    make_region(s, tree, key, parent);
     added++;
   }
   return added;
@@ -236,7 +252,7 @@ std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool
 }
 
 size_t region_memory_bytes(const region_state& s) {
-  return s.key.size() * (sizeof(uint64_t) + 3 * sizeof(int)) + s.cut_nodes.size() * sizeof(int) +
+  return s.key.size() * (sizeof(uint64_t) + 4 * sizeof(int)) + (s.cut_nodes.size() + s.pair_parent.size()) * sizeof(int) +
          s.table_key.size() * (sizeof(uint64_t) + sizeof(int));
 }
 

@@ -47,7 +47,9 @@ struct region_state {
   std::vector<int> cut_offset;         // per region: first entry in cut_nodes
   std::vector<int> cut_size;           // per region
   std::vector<int> pair_offset;        // per region: its first (region, cluster) pair
+  std::vector<int> parent;             // per region: the coarse region containing a fine one (else invalid_id)
   std::vector<int> cut_nodes;          // concatenated sorted cuts (tree node ids, then sun_cluster)
+  std::vector<int> pair_parent;        // per pair: the parent region's pair of the same cluster, or invalid_id
   int64_t pairs = 0;                   // total (region, cluster) pairs
   std::vector<uint64_t> table_key;     // open addressing; empty slots hold empty_key
   std::vector<int> table_id;
@@ -71,8 +73,8 @@ int find_region_key(const region_state& s, uint64_t key);
 // The finest existing region containing the fine cell `fine_key` (the root at worst).
 int find_region(const region_state& s, uint64_t fine_key);
 
-// Creates regions for requested fine keys (sorted, deduplicated by the caller): fine regions while the
-// pair budget allows, then their coarse parents. Returns the number of regions added.
+// Creates regions for requested fine keys (sorted, deduplicated by the caller): each fine key's coarse parent
+// first, then the fine region while the pair budget allows. Returns the number of regions added.
 int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys);
 
 // The light cut of a box: tree nodes sorted by id (then sun_cluster if has_sun), Lightcuts-style refinement of

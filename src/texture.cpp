@@ -52,11 +52,36 @@ static bool accepted_format(const std::string& b, const std::string& path) {
   return ext == ".tga";
 }
 
+// Little-endian integer of n bytes at offset off of b (0 past the end).
+static long long le(const std::string& b, size_t off, int n) {
+  long long v = 0;
+  for (int i = n - 1; i >= 0; i--) v = v * 256 + (off + size_t(i) < b.size() ? (unsigned char)b[off + size_t(i)] : 0);
+  return v;
+}
+
+// Smallest file that can hold the pixels of an uncompressed TGA or BMP of w x h texels (0 for other formats):
+// stb_image reads zeros past the end of these, so a truncated file would otherwise decode without error.
+static long long uncompressed_size(const std::string& b, long long w, long long h) {
+  if (b.size() >= 18 && b.compare(0, 2, "BM") != 0) {  // TGA (only .tga files without PNG/JPEG magic get here)
+    long long type = (unsigned char)b[2], bytes_pp = ((unsigned char)b[16] + 7) / 8;
+    long long palette = b[1] ? le(b, 5, 2) * (((unsigned char)b[7] + 7) / 8) : 0;
+    if (type >= 1 && type <= 3) return 18 + (unsigned char)b[0] + palette + w * h * bytes_pp;
+  } else if (b.size() >= 30 && b.compare(0, 2, "BM") == 0) {
+    long long header = le(b, 14, 4), bpp = header == 12 ? le(b, 24, 2) : le(b, 28, 2);
+    long long compression = header >= 40 ? le(b, 30, 4) : 0;
+    if (compression == 0 || compression == 3) return le(b, 10, 4) + (w * bpp + 31) / 32 * 4 * h;
+  }
+  return 0;
+}
+
 // stb_image's reason for the last failure (never null).
 static std::string stb_reason() {
   const char* r = stbi_failure_reason();
   return r ? r : "unknown error";
 }
+
+// Most texels a file byte may claim (see load_texture).
+constexpr long long max_texels_per_byte = 16384;
 
 // Frees stb_image's pixel buffers.
 struct stbi_deleter {
@@ -97,8 +122,16 @@ texture_data load_texture(const std::string& path) {
   int w = 0, h = 0, n = 0;
   if (!stbi_info_from_memory(data, len, &w, &h, &n)) throw input_error(path, "cannot decode image: " + stb_reason());
   if (w <= 0 || h <= 0 || n < 1 || n > 4) throw input_error(path, "cannot decode image: bad header");
-  if ((long long)w * h > max_texture_texels)
+  long long texels = (long long)w * h;
+  if (texels > max_texture_texels)
     throw input_error(path, "image too large (" + std::to_string(w) + "x" + std::to_string(h) + " texels)");
+  // No real encoder packs more than ~8300 texels in a byte (1-bit PNG at deflate's limit): a tiny file that
+  // claims a huge image is corrupt, and decoding it would only cost memory.
+  if (texels > (1LL << 20) && texels > max_texels_per_byte * (long long)bytes.size())
+    throw input_error(path, "cannot decode image: " + std::to_string(w) + "x" + std::to_string(h) +
+                                " texels cannot fit in " + std::to_string(bytes.size()) + " bytes (corrupt?)");
+  if ((long long)bytes.size() < uncompressed_size(bytes, w, h))
+    throw input_error(path, "cannot decode image: truncated");
 
   texture_data tex;
   tex.path = path;
