@@ -1,6 +1,8 @@
 // bayes_sampler: posterior cluster weights per shading point, observation recording, learning between passes.
 #include "bayes_sampler.h"
 
+#include "cluster_bounds.h"
+
 namespace bl {
 
 void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
@@ -14,15 +16,18 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   size_t base = size_t(regions.pair_offset[size_t(ctx.region)]);
   // Prior scale: a Lambertian point of albedo a turns irradiance E into radiance a E / pi.
   double scale = (sp.albedo > 0 ? sp.albedo : 1.0f) * inv_pi_f;
+  float num[max_cut_entries + 3], inv_d2[max_cut_entries + 3];
+  eval_node_bounds(*tree, ctx.nodes, ctx.tree_count, sp.p, sp.n, num, inv_d2);
+  if (ctx.tree_count < ctx.count)
+    num[ctx.tree_count] = cluster_bound_parts(*tree, *lights, sun_cluster, sp.p, sp.n, sun_sin, sun_cos,
+                                              inv_d2[ctx.tree_count]);
   double w[max_cut_entries], b[max_cut_entries];
   double sum_w = 0, sum_b = 0;
   for (int j = 0; j < ctx.count; j++) {
-    float inv_d2;
-    float num = cluster_bound_parts(*tree, *lights, ctx.nodes[j], sp.p, sp.n, sun_sin, sun_cos, inv_d2);
-    double bound = double(num) * inv_d2;
+    double bound = double(num[j]) * inv_d2[j];
     size_t i = base + size_t(j);
     int up = regions.pair_parent[i];
-    double g = params.distance_regression ? inv_d2 : 1.0;
+    double g = params.distance_regression ? inv_d2[j] : 1.0;
     w[j] = up != invalid_id && params.hierarchy > 0 ? eval_weight_blend(stats, i, size_t(up), params, scale * bound, g)
                                                     : eval_weight(stats, i, params, scale * bound, g);
     b[j] = bound;

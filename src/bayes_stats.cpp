@@ -82,7 +82,8 @@ void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
 
 void bayes_row::clear() {
   requests.clear();
-  std::fill(slots.begin(), slots.end(), -1);
+  for (int h : used) slots[size_t(h)] = -1;
+  used.clear();
   acc.clear();
 }
 
@@ -91,10 +92,12 @@ void bayes_row::add(int pair, double z) {
     // Grow and rehash (load <= 1/2).
     size_t n = std::max<size_t>(64, slots.size() * 2);
     slots.assign(n, -1);
+    used.clear();
     for (size_t i = 0; i < acc.size(); i++) {
       size_t h = size_t(mix64(uint64_t(acc[i].pair))) & (n - 1);
       while (slots[h] >= 0) h = (h + 1) & (n - 1);
       slots[h] = int(i);
+      used.push_back(int(h));
     }
   }
   size_t mask = slots.size() - 1;
@@ -102,6 +105,7 @@ void bayes_row::add(int pair, double z) {
   while (slots[h] >= 0 && acc[size_t(slots[h])].pair != pair) h = (h + 1) & mask;
   if (slots[h] < 0) {
     slots[h] = int(acc.size());
+    used.push_back(int(h));
     acc.push_back({pair, 0, 0, 0, 0});
   }
   pair_accum& a = acc[size_t(slots[h])];

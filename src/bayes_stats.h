@@ -77,6 +77,7 @@ struct bayes_row {
   region_requests requests;
   std::vector<int> slots;        // power-of-two table of indices into acc (-1: empty)
   std::vector<pair_accum> acc;   // in first-touch order (deterministic within the row)
+  std::vector<int> used;         // slots in use (cleared one by one: cheaper than refilling the table)
   void clear();
   void add(int pair, double z);
 };

@@ -1,6 +1,8 @@
 // bound_sampler: cluster weights = bounds at the shading point; regions created between passes.
 #include "bound_sampler.h"
 
+#include "cluster_bounds.h"
+
 namespace bl {
 
 void bound_sampler::prepare(context& ctx, const shade_point& sp) const {
@@ -10,9 +12,11 @@ void bound_sampler::prepare(context& ctx, const shade_point& sp) const {
     ctx.cdf[1] = 1;
     return;
   }
+  float num[max_cut_entries + 3], inv_d2[max_cut_entries + 3];
+  eval_node_bounds(*tree, ctx.nodes, ctx.tree_count, sp.p, sp.n, num, inv_d2);
   double w[max_cut_entries];
-  for (int j = 0; j < ctx.count; j++)
-    w[j] = cluster_bound(*tree, *lights, ctx.nodes[j], sp.p, sp.n, sun_sin, sun_cos);
+  for (int j = 0; j < ctx.tree_count; j++) w[j] = num[j] * inv_d2[j];
+  if (ctx.tree_count < ctx.count) w[ctx.tree_count] = cluster_bound(*tree, *lights, sun_cluster, sp.p, sp.n, sun_sin, sun_cos);
   finish_cdf(ctx, w);
 }
 

@@ -213,6 +213,10 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
   t.light.assign(nodes, invalid_id);
   builder bld{t, items};
   bld.build(0, n, invalid_id, 0);
+  t.packed.resize(nodes);
+  for (size_t i = 0; i < nodes; i++)
+    t.packed[i] = {t.center[i].x, t.center[i].y, t.center[i].z, t.radius[i], t.axis[i].x, t.axis[i].y, t.axis[i].z,
+                   t.cos_o[i],    t.sin_o[i],    t.intensity[i], 0,           0};
   return t;
 }
 

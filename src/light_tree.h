@@ -17,6 +17,11 @@ namespace bl {
 constexpr int max_sah_depth = 64;
 constexpr int max_tree_depth = 104;
 
+// Per node, the 12 floats an importance evaluation reads, packed so that one node is one gather.
+struct node_pack {
+  float cx, cy, cz, r, ax, ay, az, cos_o, sin_o, intensity, pad0, pad1;
+};
+
 // The tree as flat columns indexed by node id.
 struct light_tree_data {
   std::vector<vec3f> lo, hi;          // bounding box
@@ -29,6 +34,7 @@ struct light_tree_data {
   std::vector<int> parent;
   std::vector<int> light;             // leaf: its light id; interior: invalid_id
   std::vector<int> leaf_of_light;     // per triangle light id: its leaf node
+  std::vector<node_pack> packed;      // the columns importance reads, one record per node
   bool two_sided = false;
   int depth = 0;                      // longest root-to-leaf path (edges)
 };

@@ -6,10 +6,10 @@
 // once per file on stderr.
 #pragma once
 
+#include "obj_io.h"
+
 #include <string>
 #include <vector>
-
-#include "obj_io.h"
 
 namespace bl {
 

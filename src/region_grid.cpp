@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <queue>
 
+#include <tbb/parallel_for.h>
+
 namespace bl {
 
 namespace {
@@ -175,31 +177,41 @@ int find_region(const region_state& s, uint64_t fine_key) {
   return r != invalid_id ? r : s.root;
 }
 
-namespace {
-int make_region(region_state& s, const light_tree_data& tree, uint64_t key, int parent) {
-  if (s.shared_cut) return append_region(s, key, nullptr, parent);
-  std::vector<int> cut = compute_light_cut(tree, padded(region_box(s.grid, key)), s.has_sun, s.params);
-  return append_region(s, key, &cut, parent);
-}
-}  // namespace
-
 int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys) {
-  int added = 0;
+  // Decide which regions to create, in key order (coarse parents first; fine ones while the budget allows).
+  // Ids follow this order, so they do not depend on threads; the cuts are then computed in parallel (each is
+  // a function of its key only) and appended in the same order.
+  struct pending {
+    uint64_t key;
+    uint64_t parent_key;  // empty_region_key for coarse regions
+  };
+  std::vector<pending> todo;
+  std::vector<uint64_t> new_coarse;
   int64_t per_region = s.shared_cut ? std::max(1, s.cut_size[0]) : s.params.max_cut + 1;
+  int64_t pairs = s.pairs;
   for (uint64_t key : fine_keys) {
     if (find_region_key(s, key) != invalid_id) continue;
-    // The coarse parent first (coarse regions are at most 1/512 of the fine ones; they ignore the budget).
     uint64_t ckey = parent_region_key(s.grid, key, 1);
-    int parent = find_region_key(s, ckey);
-    if (parent == invalid_id) {
-      parent = make_region(s, tree, ckey, invalid_id);
-      added++;
+    if (find_region_key(s, ckey) == invalid_id && std::find(new_coarse.begin(), new_coarse.end(), ckey) == new_coarse.end()) {
+      // Coarse regions are at most 1/512 of the fine ones; they ignore the budget.
+      new_coarse.push_back(ckey);
+      todo.push_back({ckey, empty_region_key});
+      pairs += per_region;
     }
-    if (s.pairs + per_region > s.params.max_pairs) continue;  // over budget: the coarse region serves
-    make_region(s, tree, key, parent);
-    added++;
+    if (pairs + per_region > s.params.max_pairs) continue;  // over budget: the coarse region serves
+    todo.push_back({key, ckey});
+    pairs += per_region;
   }
-  return added;
+  std::vector<std::vector<int>> cuts(s.shared_cut ? 0 : todo.size());
+  if (!s.shared_cut)
+    tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) {
+      cuts[i] = compute_light_cut(tree, padded(region_box(s.grid, todo[i].key)), s.has_sun, s.params);
+    });
+  for (size_t i = 0; i < todo.size(); i++) {
+    int parent = todo[i].parent_key == empty_region_key ? invalid_id : find_region_key(s, todo[i].parent_key);
+    append_region(s, todo[i].key, s.shared_cut ? nullptr : &cuts[i], parent);
+  }
+  return int(todo.size());
 }
 
 // Whether node's lights light every point of the box in nearly the same proportions (splitting it would

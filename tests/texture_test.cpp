@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
@@ -194,6 +195,33 @@ TEST_CASE("missing garbage truncated and unsupported images are input errors", "
   CHECK_THAT(texture_error(dir.file("sky.hdr")), Catch::Contains("unsupported image format HDR"));
   write_bytes(dir.file("anim.gif"), "GIF89a\x01\x00\x01\x00");
   CHECK_THAT(texture_error(dir.file("anim.gif")), Catch::Contains("unsupported image format GIF"));
+}
+
+TEST_CASE("truncated TGA and BMP files and impossible sizes are input errors", "[texture]") {
+  temp_dir dir;
+  // Uncompressed 2x1 true-colour TGA (BGR texels), whole and cut short: stb_image alone would read zeros.
+  const unsigned char tga_bytes[24] = {0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 24, 0x20,
+                                       0x10, 0x20, 0x30, 0x40, 0x50, 0x60};
+  std::string tga(reinterpret_cast<const char*>(tga_bytes), sizeof tga_bytes);
+  REQUIRE(tga.size() == 24);
+  write_bytes(dir.file("ok.tga"), tga);
+  texture_data t = load_texture(dir.file("ok.tga"));
+  REQUIRE(t.width == 2);
+  CHECK(t.rgb[0].x == srgb8_to_linear(0x30));
+  write_bytes(dir.file("cut.tga"), tga.substr(0, 21));
+  CHECK_THAT(texture_error(dir.file("cut.tga")), Catch::Contains("cut.tga: cannot decode image: truncated"));
+  // A BMP written by stb, whole and cut short.
+  std::vector<unsigned char> px(8 * 8 * 3, 77);
+  REQUIRE(stbi_write_bmp(dir.file("ok.bmp").c_str(), 8, 8, 3, px.data()) != 0);
+  std::ifstream in(dir.file("ok.bmp"), std::ios::binary);
+  std::string bmp((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(load_texture(dir.file("ok.bmp")).rgb[63].y == srgb8_to_linear(77));
+  write_bytes(dir.file("cut.bmp"), bmp.substr(0, bmp.size() - 10));
+  CHECK_THAT(texture_error(dir.file("cut.bmp")), Catch::Contains("cut.bmp: cannot decode image: truncated"));
+  // 22 bytes that claim 1537x65281 texels (found by fuzzing: 1.6 GB of decoded zeros).
+  write_bytes(dir.file("tiny.tga"),
+              std::string("\x01\0\x02\0\0\0\0\xdb\0\x04\0\0\x01\x06\x01\xff\x18\x41\x78\x05\x06\x07", 22));
+  CHECK_THAT(texture_error(dir.file("tiny.tga")), Catch::Contains("cannot fit in 22 bytes"));
 }
 
 TEST_CASE("an empty texture looks up as black and opaque", "[texture]") {
