@@ -26,10 +26,8 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   for (int j = 0; j < ctx.count; j++) {
     double bound = double(num[j]) * inv_d2[j];
     size_t i = base + size_t(j);
-    int up = regions.pair_parent[i];
     double g = params.distance_regression ? inv_d2[j] : 1.0;
-    w[j] = up != invalid_id && params.hierarchy > 0 ? eval_weight_blend(stats, i, size_t(up), params, scale * bound, g)
-                                                    : eval_weight(stats, i, params, scale * bound, g);
+    w[j] = eval_weight(stats, i, params, pair_p1(stats, i, regions.pair_parent[i], params), scale * bound, g);
     b[j] = bound;
     sum_w += w[j];
     sum_b += b[j];
@@ -38,7 +36,8 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   double eps = params.prior ? params.epsilon : std::max(params.epsilon, 1e-3);
   if (eps > 0 && sum_w > 0 && sum_b > 0)
     for (int j = 0; j < ctx.count; j++) w[j] = (1 - eps) * w[j] / sum_w + eps * b[j] / sum_b;
-  finish_cdf(ctx, w);
+  // Overflowing weights (absurd radiance scales) fall back to the bound pmf rather than stopping NEE.
+  if (!finish_cdf(ctx, w)) finish_cdf(ctx, b);
 }
 
 void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {

@@ -25,7 +25,7 @@ struct bayes_sampler {
   float sun_sin = 0, sun_cos = 1;
 
   void prepare(context& ctx, const shade_point& sp) const;
-  light_choice sample(const context& ctx, float u, float u_inner) const {
+  light_choice sample(const context& ctx, double u, double u_inner) const {
     return sample_cut(ctx, *tree, *lights, u, u_inner);
   }
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }

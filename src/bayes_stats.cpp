@@ -18,7 +18,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   s.q1.resize(n);
   s.q0.resize(n);
   s.qc.resize(n);
-  s.own.resize(n);
+  s.p1.resize(n);
   if (n > old) {
     // All empty pairs share the prior-only coefficients.
     update_coeffs(s, old, p);
@@ -27,7 +27,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
       s.q1[i] = s.q1[old];
       s.q0[i] = s.q0[old];
       s.qc[i] = s.qc[old];
-      s.own[i] = s.own[old];
+      s.p1[i] = s.p1[old];
     }
   }
 }
@@ -43,37 +43,37 @@ void decay_stats(bayes_stats& s, double gamma, const bayes_params& p) {
 
 void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
   double n0 = s.n0[i], n1 = s.n1[i], z = s.mean[i], m2 = s.m2[i];
-  double q2, q1 = 0, q0 = 0, qc = 0;
+  double n = n0 + n1;
+  double q2, q1 = 0, q0 = 0, qc = 0, p1;
   if (!p.prior) {
     // Naive plug-in moments; a pair without samples follows its bound (w = v).
-    double n = n0 + n1;
     if (n == 0) {
-      q2 = 1.0;  // w = v (second moment: sqrt(v^2); mean only: v)
+      p1 = 1;
+      q2 = 1;  // second moment: sqrt(v^2) = v; mean only: v
     } else {
-      double p1 = n1 / n;
+      p1 = n1 / n;
       q2 = 0;
-      if (p.second_moment) q0 = p1 * (z * z + (n1 >= 2 ? m2 / n1 : 0.0));
-      else q1 = p1 * z;
+      if (p.second_moment) q0 = z * z + (n1 >= 2 ? m2 / n1 : 0.0);
+      else q1 = z;
     }
   } else {
-    // p1 = 1 - p0; mu_n = A mu0 + B; h = C mu0^2 + D + E (z - mu0)^2 (see bayes_stats.h).
-    double p1 = (p.b0 + n1) / (p.a0 + p.b0 + n0 + n1);
+    // p1 = E[1 - p0]; mu_n = A mu0 + B; h = C mu0^2 + D + E (z - mu0)^2 (see bayes_stats.h).
+    p1 = (p.b0 + n1) / (p.a0 + p.b0 + n);
     double kn = p.kappa0 + n1;
     double a = p.kappa0 / kn, b = n1 * z / kn;
     if (!p.second_moment) {
-      q2 = p1 * a;
-      q1 = p1 * b;
+      q2 = a;
+      q1 = b;
     } else {
       double am1 = p.alpha0 + 0.5 * n1 - 1;
       double c = p.c * (p.alpha0 - 1) / am1, d = 0.5 * m2 / am1, e = 0.5 * p.kappa0 * n1 / (kn * am1);
-      q2 = p1 * (a * a + c + e);
-      q1 = p1 * (2 * a * b - 2 * e * z);
-      q0 = p1 * (b * b + d + e * z * z);
-      qc = p1 * c;
+      q2 = a * a + c + e;
+      q1 = 2 * a * b - 2 * e * z;
+      q0 = b * b + d + e * z * z;
+      qc = c;
     }
   }
-  double n = n0 + n1;
-  s.own[i] = p.hierarchy > 0 ? float(n / (n + p.hierarchy)) : 1.0f;
+  s.p1[i] = float(p1);
   s.q2[i] = float(q2);
   s.q1[i] = float(q1);
   s.q0[i] = float(q0);

@@ -26,43 +26,41 @@ struct bayes_params {
   bool distance_regression = true;  // false: z = Y, no 1/d^2 model (ablation)
   bool prior = true;             // false: plug-in sample moments, the naive adaptive method (ablation)
   double decay = 1;              // statistics scale per animation frame (1: keep everything)
-  double hierarchy = 8;          // a fine pair leans on its coarse parent's posterior as if it were this many
-                                 // samples: weight n / (n + hierarchy) on its own (0: no hierarchy)
+  double hierarchy = 4;          // concentration of a fine pair's Beta prior on p0, centred on its coarse parent's
+                                 // posterior mean (0: no hierarchy, every pair uses Beta(a0, b0))
 };
 
 // Statistics columns, one entry per (region, cluster) pair, with the posterior folded into per-pair
-// coefficients. The posterior second moment mu_n^2 + h is a quadratic in the prior mean mu0; with the prior
-// mean of Y at the point v = scale * bound (so mu0 = v d^2) and g = 1 / d^2, the weight is
-//   w = sqrt(max(q2 v^2 + q1 v g + q0 g^2, qc v^2))       (qc v^2 = the prior-variance term, a lower bound)
-// and for the mean-only ablation w = q2 v + q1 g. Coefficients change only for pairs that got samples.
+// coefficients. The predicted second moment is E[1 - p0] * (mu_n^2 + h); mu_n^2 + h is a quadratic in the prior
+// mean mu0. With the prior mean of Y at the point v = scale * bound (so mu0 = v d^2) and g = 1 / d^2:
+//   w = sqrt(p1 * max(q2 v^2 + q1 v g + q0 g^2, qc v^2))      (qc v^2 = the prior-variance term, a lower bound)
+// and for the mean-only ablation w = p1 (q2 v + q1 g). p1 = E[1 - p0]: the pair's own posterior mean under
+// Beta(a0, b0), or for a fine pair under the hierarchical prior Beta(s (1 - p1_parent), s p1_parent),
+// p1 = (s p1_parent + n1) / (s + n). Coefficients change only for pairs that got samples.
 struct bayes_stats {
   std::vector<double> n0, n1, mean, m2;
   std::vector<float> q2, q1, q0, qc;
-  std::vector<float> own;  // n / (n + hierarchy): weight of the pair's own posterior against its parent's
+  std::vector<float> p1;  // posterior mean of 1 - p0 under Beta(a0, b0) (plug-in n1 / n for the naive ablation)
 };
 
 // Grows the columns to `pairs` entries (new pairs start empty, with prior-only coefficients).
 void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p);
 // Recomputes the coefficients of pair i from its statistics.
 void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p);
-// Weight of pair i for a point with prior mean v (= scale * bound) and g = 1 / d^2; 0 when v is 0.
-inline double eval_weight(const bayes_stats& s, size_t i, const bayes_params& p, double v, double g) {
+// E[1 - p0] of pair i, under the hierarchical prior when `up` (its parent pair) is valid.
+inline double pair_p1(const bayes_stats& s, size_t i, int up, const bayes_params& p) {
+  if (up < 0 || !(p.hierarchy > 0) || !p.prior) return s.p1[i];
+  return (p.hierarchy * s.p1[size_t(up)] + s.n1[i]) / (p.hierarchy + s.n0[i] + s.n1[i]);
+}
+// Weight of pair i with E[1 - p0] = p1 for a point with prior mean v (= scale * bound) and g = 1 / d^2;
+// 0 when v is 0.
+inline double eval_weight(const bayes_stats& s, size_t i, const bayes_params& p, double p1, double v, double g) {
   if (!(v > 0)) return 0;
-  if (!p.second_moment) return double(s.q2[i]) * v + double(s.q1[i]) * g;
+  if (!p.second_moment) return p1 * (double(s.q2[i]) * v + double(s.q1[i]) * g);
   double val = (double(s.q2[i]) * v + double(s.q1[i]) * g) * v + double(s.q0[i]) * g * g;
-  return std::sqrt(std::max(val, double(s.qc[i]) * v * v));
+  return std::sqrt(p1 * std::max(val, double(s.qc[i]) * v * v));
 }
-// Weight of fine pair i shrunk toward its coarse parent pair `up`: the predicted second moments (quadratics
-// in v and g) are blended with weight own[i] on the fine pair's, which grows with the fine pair's samples.
-inline double eval_weight_blend(const bayes_stats& s, size_t i, size_t up, const bayes_params& p, double v,
-                                double g) {
-  if (!(v > 0)) return 0;
-  double a = s.own[i], b = 1 - a;
-  double q2 = a * s.q2[i] + b * s.q2[up], q1 = a * s.q1[i] + b * s.q1[up];
-  if (!p.second_moment) return q2 * v + q1 * g;
-  double q0 = a * s.q0[i] + b * s.q0[up], qc = a * s.qc[i] + b * s.qc[up];
-  return std::sqrt(std::max((q2 * v + q1 * g) * v + q0 * g * g, qc * v * v));
-}
+
 // Scales all statistics by gamma (animation: the prior regains weight).
 void decay_stats(bayes_stats& s, double gamma, const bayes_params& p);
 

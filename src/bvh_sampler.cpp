@@ -13,52 +13,52 @@ void bvh_sampler::prepare(context& ctx, const shade_point& sp) const {
   ctx.n = sp.n;
   float is = sun_importance(*lights, sp.n, sun_sin, sun_cos);
   float it = node_count(*tree) > 0 ? node_importance(*tree, 0, sp.p, sp.n) : 0.0f;
-  float total = is + it;
-  ctx.p_sun = total > 0 ? is / total : 0.0f;
-  ctx.p_tree = total > 0 ? (is > 0 ? 1 - ctx.p_sun : 1.0f) : 0.0f;
+  ctx.p_sun = is > 0 ? left_share(is, it) : 0.0;
+  ctx.p_tree = it > 0 ? 1 - ctx.p_sun : 0.0;
 }
 
-light_choice bvh_sampler::sample(const context& ctx, float u, float) const {
-  if (ctx.p_sun > 0 && u < ctx.p_sun) return {lights->sun, ctx.p_sun};
+light_choice bvh_sampler::sample(const context& ctx, double u, double) const {
+  if (ctx.p_sun > 0 && u < ctx.p_sun) return {lights->sun, float(ctx.p_sun)};
   if (!(ctx.p_tree > 0)) return {};
-  u = std::min((u - ctx.p_sun) / ctx.p_tree, 0x1.fffffep-1f);
-  float prob = ctx.p_tree;
+  u = std::min((u - ctx.p_sun) / ctx.p_tree, 0x1.fffffffffffffp-1);
+  double prob = ctx.p_tree;
   int node = 0;
   while (!is_leaf(*tree, node)) {
     int l = tree->left[size_t(node)], r = tree->right[size_t(node)];
     float il = node_importance(*tree, l, ctx.p, ctx.n), ir = node_importance(*tree, r, ctx.p, ctx.n);
+    // Both children unable to reach the point: this sample is lost (as in pbrt-v4); pmf() accounts for it.
     if (!(il + ir > 0)) return {};
-    float pl = il / (il + ir);
+    double pl = left_share(il, ir);
     if (u < pl) {
-      u = std::min(u / pl, 0x1.fffffep-1f);
+      u = std::min(u / pl, 0x1.fffffffffffffp-1);
       prob *= pl;
       node = l;
     } else {
-      u = std::min((u - pl) / (1 - pl), 0x1.fffffep-1f);
+      u = std::min((u - pl) / (1 - pl), 0x1.fffffffffffffp-1);
       prob *= 1 - pl;
       node = r;
     }
   }
   if (!(prob > 0)) return {};
-  return {tree->light[size_t(node)], prob};
+  return {tree->light[size_t(node)], float(prob)};
 }
 
 float bvh_sampler::pmf(const context& ctx, int light) const {
-  if (light == lights->sun) return ctx.p_sun;
+  if (light == lights->sun) return float(ctx.p_sun);
   if (!(ctx.p_tree > 0)) return 0;
   int path[max_tree_depth + 1];
   int len = 0;
   for (int n = tree->leaf_of_light[size_t(light)]; n != 0; n = tree->parent[size_t(n)]) path[len++] = n;
-  float prob = ctx.p_tree;
+  double prob = ctx.p_tree;
   for (int k = len - 1; k >= 0; k--) {
     int child = path[k], parent = tree->parent[size_t(child)];
     int l = tree->left[size_t(parent)], r = tree->right[size_t(parent)];
     float il = node_importance(*tree, l, ctx.p, ctx.n), ir = node_importance(*tree, r, ctx.p, ctx.n);
     if (!(il + ir > 0)) return 0;
-    float pl = il / (il + ir);
+    double pl = left_share(il, ir);
     prob *= child == l ? pl : 1 - pl;
   }
-  return prob;
+  return float(prob);
 }
 
 }  // namespace bl

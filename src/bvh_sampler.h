@@ -16,15 +16,15 @@ struct bvh_sampler {
   // Per shading point: the point and the top-level split between the sun and the tree.
   struct context {
     vec3f p, n;
-    float p_sun = 0;     // probability of the sun
-    float p_tree = 0;    // probability of the tree (1 - p_sun, or 0)
+    double p_sun = 0;    // probability of the sun
+    double p_tree = 0;   // probability of the tree (1 - p_sun, or 0)
   };
   const light_tree_data* tree = nullptr;
   const light_data* lights = nullptr;
   float sun_sin = 0, sun_cos = 1;  // sun disk half-angle
 
   void prepare(context& ctx, const shade_point& sp) const;
-  light_choice sample(const context& ctx, float u, float) const;
+  light_choice sample(const context& ctx, double u, double) const;
   float pmf(const context& ctx, int light) const;
   void end_pass() {}
 };

@@ -200,7 +200,7 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1)")
       ->check(CLI::Range(1.000001, 1e9))->group(bg);
   r->add_option("--bayes-hierarchy", o.bayes.hierarchy,
-                "Fine regions lean on their coarse parent's posterior as if it were this many samples (0 = off)")
+                "Concentration of a fine region's Beta prior on p0, centred on its coarse parent's posterior (0 = off)")
       ->check(CLI::Range(0.0, 1e9))->group(bg);
   r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0)")
       ->check(CLI::PositiveNumber)->group(bg);

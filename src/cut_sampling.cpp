@@ -1,6 +1,8 @@
 // cut_sampling: region lookup, cdf construction, cluster + intensity-descent sampling and its pmf.
 #include "cut_sampling.h"
 
+#include "sampling.h"
+
 #include <algorithm>
 
 namespace bl {
@@ -16,41 +18,25 @@ void locate_region(cut_context& ctx, const region_state& regions, const shade_po
   ctx.tree_count = ctx.count - (regions.has_sun ? 1 : 0);
 }
 
-void finish_cdf(cut_context& ctx, const double* w) {
-  double total = 0;
-  for (int j = 0; j < ctx.count; j++) total += w[j];
-  ctx.cdf[0] = 0;
-  if (!(total > 0) || !std::isfinite(total)) {
-    for (int j = 0; j < ctx.count; j++) ctx.cdf[j + 1] = 0;
-    return;
-  }
-  double acc = 0, inv = 1 / total;
-  int last = -1;
-  for (int j = 0; j < ctx.count; j++) {
-    acc += w[j];
-    ctx.cdf[j + 1] = float(acc * inv);
-    if (w[j] > 0) last = j;
-  }
-  for (int j = last; j < ctx.count; j++) ctx.cdf[j + 1] = 1.0f;
-}
+bool finish_cdf(cut_context& ctx, const double* w) { return fill_cdf(w, ctx.count, ctx.cdf); }
 
-light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, float u,
-                        float u_inner) {
+light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, double u,
+                        double u_inner) {
   if (ctx.count == 0 || !(ctx.cdf[ctx.count] > 0)) return {};
-  int j = int(std::upper_bound(ctx.cdf + 1, ctx.cdf + ctx.count + 1, u) - (ctx.cdf + 1));
-  j = std::min(j, ctx.count - 1);
-  float pj = cluster_pmf(ctx, j);
+  int j = sample_cdf(ctx.cdf, ctx.count, u);
+  double pj = cluster_pmf(ctx, j);
   if (!(pj > 0)) return {};
   int node = ctx.nodes[j];
-  if (node == sun_cluster) return {lights.sun, pj, j, 1.0f};
-  float inner = 1;
+  if (node == sun_cluster) return {lights.sun, float(pj), j, 1.0f};
+  double inner = 1;
   int leaf = sample_by_intensity(tree, node, u_inner, inner);
-  return {tree.light[size_t(leaf)], pj * inner, j, inner};
+  return {tree.light[size_t(leaf)], float(pj * inner), j, float(inner)};
 }
 
 float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, int light) {
   if (ctx.count == 0) return 0;
-  if (light == lights.sun) return ctx.nodes[ctx.count - 1] == sun_cluster ? cluster_pmf(ctx, ctx.count - 1) : 0.0f;
+  if (light == lights.sun)
+    return ctx.nodes[ctx.count - 1] == sun_cluster ? float(cluster_pmf(ctx, ctx.count - 1)) : 0.0f;
   int leaf = tree.leaf_of_light[size_t(light)];
   const int* begin = ctx.nodes;
   const int* end = ctx.nodes + ctx.tree_count;
@@ -58,7 +44,7 @@ float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_d
     const int* it = std::lower_bound(begin, end, n);
     if (it != end && *it == n) {
       int j = int(it - begin);
-      return cluster_pmf(ctx, j) * intensity_descent_pmf(tree, n, leaf);
+      return float(cluster_pmf(ctx, j) * intensity_descent_pmf(tree, n, leaf));
     }
   }
   return 0;  // the light's subtree was left out of the cut: it cannot reach this region

@@ -27,7 +27,7 @@ struct cut_context {
   int count = 0;               // clusters in the cut
   int tree_count = 0;          // of which tree nodes (the sun, if any, is last)
   const int* nodes = nullptr;  // the cut's node ids
-  float cdf[max_cut_entries + 1];
+  double cdf[max_cut_entries + 1];
 };
 
 // Fills the point and region part of a context.
@@ -54,14 +54,15 @@ inline float cluster_distance(const light_tree_data& tree, int node, vec3f p) {
   return std::max(length(p - tree.center[size_t(node)]), tree.radius[size_t(node)]);
 }
 
-// Normalises non-negative weights (accumulated in double, in cut order) into ctx.cdf.
-void finish_cdf(cut_context& ctx, const double* weights);
+// Normalises non-negative weights (in cut order, positive ones floored as in fill_cdf) into ctx.cdf; false when
+// no weight is positive and finite.
+bool finish_cdf(cut_context& ctx, const double* weights);
 // Probability of cluster j.
-inline float cluster_pmf(const cut_context& ctx, int j) { return ctx.cdf[j + 1] - ctx.cdf[j]; }
+inline double cluster_pmf(const cut_context& ctx, int j) { return ctx.cdf[j + 1] - ctx.cdf[j]; }
 
 // Picks a cluster with u and a light inside it with u_inner.
-light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, float u,
-                        float u_inner);
+light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, double u,
+                        double u_inner);
 // Probability that sample_cut picks `light`.
 float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, int light);
 

@@ -113,7 +113,8 @@ vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, 
     sampler.prepare(ctx, shade_point{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth});
 
     // Next-event estimation.
-    light_choice choice = sampler.sample(ctx, r.u[dim_light_select], r.u[dim_light_inner]);
+    light_choice choice = sampler.sample(ctx, r.u53(dim_light_select, dim_light_select_lo),
+                                         r.u53(dim_light_inner, dim_light_inner_lo));
     if (choice.light != invalid_id && choice.prob > 0) {
       st.nee_samples++;
       float value = 0;

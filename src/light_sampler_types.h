@@ -3,7 +3,7 @@
 // The contract of a sampler type S (dispatched once per pass by std::visit, never per sample):
 //   S::context                               per-vertex scratch, filled by prepare (no allocation)
 //   void prepare(context&, const shade_point&) const
-//   light_choice sample(const context&, float u_select, float u_inner) const
+//   light_choice sample(const context&, double u_select, double u_inner) const   (53-bit uniforms)
 //   float pmf(const context&, int light) const      exactly the probability sample() gives `light`
 //   void end_pass()                                  between passes (non-learning samplers)
 //   static constexpr bool learns; learners also have S::row_state, record(row_state&, const nee_event&)
@@ -42,7 +42,7 @@ struct light_choice {
   int light = invalid_id;
   float prob = 0;
   int cluster = invalid_id;
-  float prob_in_cluster = 1;  // P(light | cluster); prob = P(cluster) * prob_in_cluster
+  float prob_in_cluster = 1;  // P(light | cluster); prob = P(cluster) * prob_in_cluster (both rounded from double)
 };
 
 // One NEE event as a learning sampler sees it: its own context, the choice, and the sample's luminance

@@ -240,38 +240,37 @@ float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi) 
 }
 
 // Probability of taking the left child of an interior node when descending by intensity.
-static float left_probability(const light_tree_data& t, int node) {
-  float il = t.intensity[size_t(t.left[size_t(node)])], ir = t.intensity[size_t(t.right[size_t(node)])];
-  return il + ir > 0 ? il / (il + ir) : 0.5f;
+static double left_probability(const light_tree_data& t, int node) {
+  return left_share(t.intensity[size_t(t.left[size_t(node)])], t.intensity[size_t(t.right[size_t(node)])]);
 }
 
-float intensity_descent_pmf(const light_tree_data& t, int node, int leaf) {
-  // Collect the path bottom-up, then multiply top-down: the same float products as sample_by_intensity.
+double intensity_descent_pmf(const light_tree_data& t, int node, int leaf) {
+  // Collect the path bottom-up, then multiply top-down: the same products as sample_by_intensity.
   int path[max_tree_depth + 1];
   int len = 0;
   for (int n = leaf; n != node; n = t.parent[size_t(n)]) {
     if (n == invalid_id || len > max_tree_depth) return 0;  // leaf is not below node
     path[len++] = n;
   }
-  float prob = 1;
+  double prob = 1;
   for (int k = len - 1; k >= 0; k--) {
     int child = path[k], p = t.parent[size_t(child)];
-    float pl = left_probability(t, p);
+    double pl = left_probability(t, p);
     prob *= t.left[size_t(p)] == child ? pl : 1 - pl;
   }
   return prob;
 }
 
-int sample_by_intensity(const light_tree_data& t, int node, float u, float& prob) {
+int sample_by_intensity(const light_tree_data& t, int node, double u, double& prob) {
   prob = 1;
   while (!is_leaf(t, node)) {
-    float pl = left_probability(t, node);
+    double pl = left_probability(t, node);
     if (u < pl) {
-      u = std::min(u / pl, 0x1.fffffep-1f);
+      u = std::min(u / pl, 0x1.fffffffffffffp-1);
       prob *= pl;
       node = t.left[size_t(node)];
     } else {
-      u = std::min((u - pl) / (1 - pl), 0x1.fffffep-1f);
+      u = std::min((u - pl) / (1 - pl), 0x1.fffffffffffffp-1);
       prob *= 1 - pl;
       node = t.right[size_t(node)];
     }

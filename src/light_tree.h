@@ -110,11 +110,20 @@ inline float node_importance(const light_tree_data& t, int node, vec3f p, vec3f 
 // (clamped below by the square of the region's half diagonal so that nearby nodes rank first, not infinitely).
 float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi);
 
+// Probability of the left child when descending by weights (il, ir): il / (il + ir) in double, kept inside
+// [min_positive_share, 1 - min_positive_share] when both are positive so that no positive child starves.
+inline double left_share(double il, double ir) {
+  if (!(il + ir > 0)) return 0.5;
+  double pl = il / (il + ir);
+  if (il > 0 && ir > 0) pl = std::min(std::max(pl, 0x1p-40), 1 - 0x1p-40);
+  return pl;
+}
+
 // Probability that descending from `node` proportionally to intensity reaches leaf `leaf` (product of
 // the intensity ratios on the way; exactly what sample_by_intensity realises).
-float intensity_descent_pmf(const light_tree_data& t, int node, int leaf);
+double intensity_descent_pmf(const light_tree_data& t, int node, int leaf);
 // Descends from `node` to a leaf choosing children proportionally to intensity with uniform u (rescaled
 // at every level); returns the leaf node and writes the probability of the path.
-int sample_by_intensity(const light_tree_data& t, int node, float u, float& prob);
+int sample_by_intensity(const light_tree_data& t, int node, double u, double& prob);
 
 }  // namespace bl

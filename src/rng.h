@@ -23,12 +23,21 @@ enum rng_dim : int {
   dim_bsdf_u = 5,        // direction inside the lobe
   dim_bsdf_v = 6,        //
   dim_roulette = 7,      // Russian roulette
-  dims_per_vertex = 8
+  dim_light_select_lo = 8,  // low bits of the two light choices (they use 53-bit uniforms, see u53)
+  dim_light_inner_lo = 9,
+  dims_per_vertex = 10
 };
 
-// One vertex's uniforms in [0, 1).
+// One vertex's uniforms in [0, 1) (24-bit floats) and the raw draws behind them.
 struct vertex_randoms {
   float u[dims_per_vertex];
+  uint32_t raw[dims_per_vertex];
+  // A 53-bit uniform in [0, 1) from two draws: discrete choices over many lights (or deep tree descents) need
+  // more resolution than 24 bits, or a light with probability below 2^-24 could never be chosen.
+  double u53(int hi, int lo) const {
+    uint64_t bits = (uint64_t(raw[hi]) << 21) ^ (uint64_t(raw[lo]) >> 11);
+    return double(bits & ((uint64_t(1) << 53) - 1)) * 0x1p-53;
+  }
 };
 
 // 64-bit finaliser (splitmix64): decorrelates nearby keys.
@@ -51,7 +60,10 @@ inline float uint_to_unit(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
 inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex) {
   pcg32 rng(key, vertex);
   vertex_randoms r;
-  for (int i = 0; i < dims_per_vertex; i++) r.u[i] = uint_to_unit(rng());
+  for (int i = 0; i < dims_per_vertex; i++) {
+    r.raw[i] = rng();
+    r.u[i] = uint_to_unit(r.raw[i]);
+  }
   return r;
 }
 

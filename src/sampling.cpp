@@ -5,31 +5,42 @@
 
 namespace bl {
 
+bool fill_cdf(const double* w, int n, double* cdf) {
+  double total = 0;
+  for (int i = 0; i < n; i++) total += w[i] > 0 ? w[i] : 0.0;
+  cdf[0] = 0;
+  if (!(total > 0) || !std::isfinite(total)) {
+    for (int i = 0; i < n; i++) cdf[i + 1] = 0;
+    return false;
+  }
+  // Floor every positive weight so that no item that can contribute rounds to probability zero.
+  double floor = total * min_positive_share, acc = 0;
+  int last = -1;
+  for (int i = 0; i < n; i++) {
+    if (w[i] > 0) {
+      acc += std::max(w[i], floor);
+      last = i;
+    }
+    cdf[i + 1] = acc;
+  }
+  double inv = 1 / acc;
+  for (int i = 0; i < n; i++) cdf[i + 1] *= inv;
+  for (int i = last; i < n; i++) cdf[i + 1] = 1.0;  // exact end point
+  return true;
+}
+
 discrete_data make_discrete(const float* weights, int n) {
   discrete_data d;
-  double total = 0;
-  for (int i = 0; i < n; i++) total += weights[i] > 0 ? double(weights[i]) : 0.0;
-  if (!(total > 0) || !std::isfinite(total)) return d;
+  std::vector<double> w(static_cast<size_t>(n));
+  for (int i = 0; i < n; i++) w[size_t(i)] = weights[i];
   d.cdf.resize(size_t(n) + 1);
-  double acc = 0;
-  d.cdf[0] = 0;
-  for (int i = 0; i < n; i++) {
-    acc += weights[i] > 0 ? double(weights[i]) : 0.0;
-    d.cdf[size_t(i) + 1] = float(acc / total);
-  }
-  // Exact end point; items after the last positive weight get zero width.
-  int last = n - 1;
-  while (last > 0 && !(weights[last] > 0)) last--;
-  for (int i = last; i < n; i++) d.cdf[size_t(i) + 1] = 1.0f;
+  if (!fill_cdf(w.data(), n, d.cdf.data())) d.cdf.clear();
   return d;
 }
 
-int sample_discrete(const discrete_data& d, float u) {
-  if (d.cdf.empty()) return -1;
+int sample_cdf(const double* cdf, int n, double u) {
   // First cdf entry > u, minus one: the item whose half-open cell [cdf[i], cdf[i+1]) contains u.
-  auto it = std::upper_bound(d.cdf.begin(), d.cdf.end(), u);
-  int i = int(it - d.cdf.begin()) - 1;
-  int n = int(d.cdf.size()) - 1;
+  int i = int(std::upper_bound(cdf + 1, cdf + n + 1, u) - (cdf + 1));
   return std::min(std::max(i, 0), n - 1);
 }
 

@@ -51,23 +51,28 @@ inline float power_heuristic(float pdf_a, float pdf_b) {
   return a / (a + b);
 }
 
+// Smallest probability of an item with positive weight, relative to the total: far below anything that changes
+// an estimate's variance, far above the resolution of a 53-bit uniform (2^-53), so every such item can be chosen.
+constexpr double min_positive_share = 0x1p-40;
+
 // A discrete distribution over n items built from non-negative weights.
 struct discrete_data {
-  std::vector<float> cdf;  // n + 1 entries, cdf[0] = 0, cdf[n] = 1 (empty when all weights are zero)
+  std::vector<double> cdf;  // n + 1 entries, cdf[0] = 0, cdf[n] = 1 (empty when all weights are zero)
 };
 
-// Builds the cdf (accumulated in double, in index order).
+// Builds the cdf (accumulated in double, in index order; positive weights floored at min_positive_share).
 discrete_data make_discrete(const float* weights, int n);
-// Index i with cdf[i] <= u < cdf[i+1]; never an item of probability zero. -1 when the distribution is empty.
-int sample_discrete(const discrete_data& d, float u);
-// Probability of item i (exactly what sample_discrete realises).
-inline float discrete_pmf(const discrete_data& d, int i) {
-  return d.cdf.empty() ? 0.0f : d.cdf[size_t(i) + 1] - d.cdf[size_t(i)];
+// Fills cdf[0..n] from non-negative weights as make_discrete does; false (cdf all zero) when none is positive.
+bool fill_cdf(const double* weights, int n, double* cdf);
+// Index i with cdf[i] <= u < cdf[i+1] in cdf[0..n]; never an item of probability zero.
+int sample_cdf(const double* cdf, int n, double u);
+// Index sampled from d with u; -1 when the distribution is empty.
+inline int sample_discrete(const discrete_data& d, double u) {
+  return d.cdf.empty() ? -1 : sample_cdf(d.cdf.data(), int(d.cdf.size()) - 1, u);
 }
-// u rescaled into [0, 1) inside the cell of item i (reuse of one uniform for a nested choice).
-inline float discrete_remap(const discrete_data& d, int i, float u) {
-  float lo = d.cdf[size_t(i)], w = d.cdf[size_t(i) + 1] - lo;
-  return w > 0 ? std::min((u - lo) / w, 0x1.fffffep-1f) : 0.0f;
+// Probability of item i (exactly what sample_discrete realises).
+inline double discrete_pmf(const discrete_data& d, int i) {
+  return d.cdf.empty() ? 0.0 : d.cdf[size_t(i) + 1] - d.cdf[size_t(i)];
 }
 
 }  // namespace bl

@@ -12,9 +12,9 @@ struct uniform_sampler {
   struct context {};
   int count = 0;
   void prepare(context&, const shade_point&) const {}
-  light_choice sample(const context&, float u, float) const {
+  light_choice sample(const context&, double u, double) const {
     if (count == 0) return {};
-    int i = std::min(int(u * float(count)), count - 1);
+    int i = std::min(int(u * double(count)), count - 1);
     return {i, 1.0f / float(count)};
   }
   float pmf(const context&, int) const { return count > 0 ? 1.0f / float(count) : 0.0f; }
@@ -27,12 +27,12 @@ struct power_sampler {
   struct context {};
   discrete_data dist;
   void prepare(context&, const shade_point&) const {}
-  light_choice sample(const context&, float u, float) const {
+  light_choice sample(const context&, double u, double) const {
     int i = sample_discrete(dist, u);
     if (i < 0) return {};
-    return {i, discrete_pmf(dist, i)};
+    return {i, float(discrete_pmf(dist, i))};
   }
-  float pmf(const context&, int light) const { return discrete_pmf(dist, light); }
+  float pmf(const context&, int light) const { return float(discrete_pmf(dist, light)); }
   void end_pass() {}
 };
 

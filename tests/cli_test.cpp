@@ -188,3 +188,32 @@ TEST_CASE("help lists the samplers and options", "[cli]") {
                         "--quiet", "bayes"})
     CHECK(r.output.find(s) != std::string::npos);
 }
+
+TEST_CASE("an interrupted render writes the completed passes and exits 130 or 143", "[cli]") {
+  tiny_scene s;
+  for (const char* sig : {"INT", "TERM"}) {
+    std::string out = s.dir / (std::string("int_") + sig + ".pfm"), log = s.dir / "int.csv";
+    // A render far too long to finish, stopped after a second by the signal.
+    std::string cmd = std::string("( ") + BAYESLIGHT_BINARY + " render " + s.json +
+                      " --sampler bayes --spp 100000000 --width 64 --height 48 --quiet -o " + out + " --log " + log +
+                      " >/dev/null 2>&1 & pid=$!; sleep 1; kill -" + sig + " $pid; wait $pid; echo $? )";
+    FILE* p = popen(cmd.c_str(), "r");
+    REQUIRE(p);
+    char buf[64] = {0};
+    REQUIRE(fgets(buf, sizeof buf, p));
+    pclose(p);
+    int status = std::atoi(buf);
+    INFO(sig);
+    CHECK(status == (std::string(sig) == "INT" ? 130 : 143));
+    REQUIRE(exists(out));
+    image_data img = read_image(out);
+    CHECK(img.width == 64);
+    for (float v : img.pixels) REQUIRE(std::isfinite(v));
+    // The log lists exactly the completed passes.
+    std::ifstream f(log);
+    std::string line;
+    int rows = -1;
+    while (std::getline(f, line)) rows++;
+    CHECK(rows >= 1);
+  }
+}

@@ -3,8 +3,10 @@
 // everything), with and without a sun: at many shading points on the scene's surfaces the pmf sums to 1 (or 0
 // when no light can contribute) within 1e-5, sample() returns prob bitwise equal to pmf() (MIS needs it),
 // sampled frequencies match the pmf (chi-square, significance 1e-3 per test, 100k samples, fixed seeds), and
-// every light that can contribute has pmf > 0. The learning samplers are checked again after learning from
-// passes of real paths.
+// every light that can contribute has pmf > 0, however small its share of the selection weight. The learning
+// samplers are checked again after learning from passes of real paths. Exception, stated where it applies: the bvh
+// sampler (like pbrt-v4's) may give up in a subtree whose children both prove dark, so its pmf may sum to < 1;
+// the missing mass must then be exactly the frequency of "no light" (part of the chi-square test).
 #include "bvh.h"
 #include "integrator.h"
 #include "light_sampler.h"
@@ -281,8 +283,11 @@ contract_report check_contract(const test_scene& t, const S& s, const std::vecto
         rep.prob_mismatch++;
       }
       if constexpr (std::is_same_v<typename S::context, cut_context>) {
-        // prob = P(cluster) * P(light | cluster), the split the learner's observations rely on.
-        if (c.cluster < 0 || c.cluster >= ctx.count || !same_bits(c.prob, cluster_pmf(ctx, c.cluster) * c.prob_in_cluster))
+        // prob = P(cluster) * P(light | cluster), the split the learner's observations rely on (both factors are
+        // rounded from double separately, so the product agrees to float resolution, not bit for bit).
+        bool valid = c.cluster >= 0 && c.cluster < ctx.count;
+        double split = valid ? cluster_pmf(ctx, c.cluster) * double(c.prob_in_cluster) : 0.0;
+        if (!valid || std::fabs(double(c.prob) - split) > 2e-7 * split)
           rep.bad_cluster_split++;
       }
     }
@@ -349,7 +354,7 @@ TEST_CASE("every light sampler satisfies the sampling contract", "[samplers]") {
         // The bvh sampler, like pbrt-v4's, gives up when both children of a node it descended into turn out to
         // have zero importance: its pmf may sum to less than 1 (the rest is "no light", checked by chi-square).
         bool lossy = kind == sampler_kind::bvh;
-        std::visit([&](const auto& s) { require_contract(check_contract(*t, s, pts, 4, 100 + variant, lossy)); }, ls);
+        std::visit([&](const auto& s) { require_contract(check_contract(*t, s, pts, 8, 100 + variant, lossy)); }, ls);
       }
     }
   }
@@ -370,7 +375,7 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
                 path_stats st = learn_passes(t->in, s, 6);
                 CHECK(st.bad_samples == 0);
                 CHECK(st.nee_samples > 0);
-                require_contract(check_contract(*t, s, pts, 4, 200 + variant));
+                require_contract(check_contract(*t, s, pts, 8, 200 + variant));
               }
             },
             ls);

@@ -1,7 +1,7 @@
 // Tests of the light tree: structural invariants over random triangle-light sets (leaves, parent/child links,
 // nested boxes, summed intensities, normal cones, depth, deterministic build), intensity descent (chi-square
 // of sampled leaves against intensity_descent_pmf at significance 1e-3, returned probabilities bitwise equal
-// to the pmf), conservativeness of node_importance and node_region_bound (a zero never hides a light that can
+// to the pmf, every leaf of positive intensity reachable with probability > 0), conservativeness of node_importance and node_region_bound (a zero never hides a light that can
 // reach the point), and the partition property of compute_light_cut.
 #include "light_tree.h"
 #include "lights.h"
@@ -15,6 +15,7 @@
 
 #include <cstring>
 #include <functional>
+#include <sstream>
 
 using namespace bl;
 using namespace bl::test;
@@ -119,7 +120,15 @@ void leaves_under(const light_tree_data& t, int node, std::vector<int>& out) {
   leaves_under(t, t.right[size_t(node)], out);
 }
 
+std::string sci(double v) {
+  std::ostringstream o;
+  o.precision(3);
+  o << std::scientific << v;
+  return o.str();
+}
+
 bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 bool same_bits(vec3f a, vec3f b) { return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z); }
 template <class T>
 bool same_column(const std::vector<T>& a, const std::vector<T>& b) {
@@ -334,16 +343,31 @@ TEST_CASE("intensity descent samples leaves with the probability its pmf states"
       for (size_t j = 0; j < leaves.size(); j++) bin[size_t(leaves[j])] = int(j);
       std::vector<double> obs(leaves.size(), 0.0), exp(leaves.size(), 0.0);
       double total = 0;
+      int starved = 0;
+      std::string which;
       for (size_t j = 0; j < leaves.size(); j++) {
-        float pmf = intensity_descent_pmf(t, start, leaves[j]);
+        double pmf = intensity_descent_pmf(t, start, leaves[j]);
         CHECK(pmf >= 0);
+        // Unbiasedness inside a cluster: a light with positive intensity keeps a positive probability.
+        if (t.intensity[size_t(leaves[j])] > 0 && !(pmf > 0)) {
+          starved++;
+          if (starved <= 3)
+            which += " leaf " + std::to_string(leaves[j]) + " (intensity " +
+                     sci(t.intensity[size_t(leaves[j])]) + ", sibling " +
+                     sci(t.intensity[size_t(t.left[size_t(t.parent[size_t(leaves[j])])] == leaves[j]
+                                                           ? t.right[size_t(t.parent[size_t(leaves[j])])]
+                                                           : t.left[size_t(t.parent[size_t(leaves[j])])])]) +
+                     ")";
+        }
         exp[j] = samples * double(pmf);
         total += pmf;
       }
       CHECK(std::fabs(total - 1) < 1e-5);
+      INFO("leaves with positive intensity but descent probability 0:" << which);
+      CHECK(starved == 0);
       int mismatches = 0, outside = 0;
       for (int i = 0; i < samples; i++) {
-        float prob = -1;
+        double prob = -1;
         int leaf = sample_by_intensity(t, start, unif(rng), prob);
         if (leaf < 0 || leaf >= node_count(t) || bin[size_t(leaf)] < 0) {
           outside++;

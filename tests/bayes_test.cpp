@@ -1,0 +1,697 @@
+// Tests of the Bayesian statistics and sampler (METHOD.md sections 3-5): the reference posterior against the
+// conjugate Normal-inverse-gamma / Beta update written out independently here, the fast coefficient form against
+// the reference, prior-only weights proportional to the bound, order-independent merging (Chan vs one pass),
+// convergence of a learned PMF to sqrt((1 - p0)(k^2 + h)) / d^2 with a tolerance derived from the estimator's
+// standard deviation, and the ablations (mean only, no prior, no distance regression).
+#include "bayes_sampler.h"
+#include "bayes_stats.h"
+#include "bound_sampler.h"
+#include "bvh.h"
+#include "integrator.h"
+#include "light_sampler.h"
+#include "rng.h"
+#include "scene.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+#include <memory>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+double unif(pcg32& r) { return (double(r() >> 5) * 67108864.0 + double(r() >> 6)) * (1.0 / 9007199254740992.0); }
+double log_uniform(pcg32& r, double lo, double hi) { return lo * std::pow(hi / lo, unif(r)); }
+// Standard normal (Box-Muller).
+double normal(pcg32& r) {
+  double u1 = 1 - unif(r), u2 = unif(r);
+  return std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
+}
+
+// The conjugate posterior written out from METHOD.md section 4 with raw sums (long double), independent of
+// bayes_stats.cpp: returns sqrt((1 - p0)(k^2 + h)) / d^2 with point estimates k = mu_n, h = beta_n / (alpha_n - 1),
+// 1 - p0 the posterior mean of the non-zero probability; or the mean-only ablation (1 - p0) mu_n / d^2.
+long double hand_posterior(const bayes_params& p, double bound, double scale, double d, const std::vector<double>& y,
+                           bool second_moment = true) {
+  long double d2 = (long double)d * d;
+  long double mu0 = (long double)scale * bound * d2;
+  long double n0 = 0, n1 = 0, s1 = 0, s2 = 0;
+  for (double v : y) {
+    if (v == 0) {
+      n0 += 1;
+      continue;
+    }
+    long double z = v * d2;
+    n1 += 1;
+    s1 += z;
+    s2 += z * z;
+  }
+  long double one_minus_p0 = (p.b0 + n1) / (p.a0 + p.b0 + n0 + n1);  // Beta(a0 + n0, b0 + n1): mean of 1 - p0
+  long double kn = p.kappa0 + n1;
+  long double mun = (p.kappa0 * mu0 + s1) / kn;
+  if (!second_moment) return one_minus_p0 * mun / d2;
+  long double an = p.alpha0 + n1 / 2;
+  long double beta0 = p.c * mu0 * mu0 * (p.alpha0 - 1);
+  long double bn = beta0 + 0.5L * (s2 + p.kappa0 * mu0 * mu0 - kn * mun * mun);
+  long double h = bn / (an - 1);
+  return std::sqrt(one_minus_p0 * (mun * mun + h)) / d2;
+}
+
+// The naive plug-in ablation written out: p0 = n0 / n, k = mean z, h = population variance of z; no samples:
+// the bound itself.
+long double hand_naive(double bound, double scale, double d, const std::vector<double>& y, bool second_moment) {
+  long double d2 = (long double)d * d;
+  long double n0 = 0, n1 = 0, s1 = 0, s2 = 0;
+  for (double v : y) {
+    if (v == 0) {
+      n0 += 1;
+      continue;
+    }
+    long double z = v * d2;
+    n1 += 1;
+    s1 += z;
+    s2 += z * z;
+  }
+  if (n0 + n1 == 0) return (long double)scale * bound;
+  long double p1 = n1 / (n0 + n1);
+  if (n1 == 0) return 0;
+  long double k = s1 / n1, h = s2 / n1 - k * k;
+  if (!second_moment) return p1 * k / d2;
+  return std::sqrt(p1 * (k * k + h)) / d2;
+}
+
+// Count, mean and sum of squared deviations of the non-zero z = y d^2 (two-pass, long double).
+struct moments {
+  double n0 = 0, n1 = 0, mean = 0, m2 = 0;
+};
+moments exact_moments(const std::vector<double>& z) {
+  moments m;
+  long double s = 0;
+  for (double v : z) {
+    if (v == 0) m.n0 += 1;
+    else m.n1 += 1, s += v;
+  }
+  long double mean = m.n1 > 0 ? s / m.n1 : 0, ss = 0;
+  for (double v : z)
+    if (v != 0) ss += (v - mean) * (v - mean);
+  m.mean = double(mean);
+  m.m2 = double(ss);
+  return m;
+}
+
+double rel_err(double a, double b) { return std::fabs(a - b) / std::max(std::fabs(b), 1e-300); }
+
+// Parameter sets: the defaults, and a different prior.
+std::vector<bayes_params> param_sets() {
+  bayes_params a;
+  bayes_params b;
+  b.a0 = 2;
+  b.b0 = 2;
+  b.kappa0 = 3;
+  b.alpha0 = 1.5;
+  b.c = 0.5;
+  return {a, b};
+}
+
+// Synthetic observations Y: zeros with probability p0, else |N(k, h)| / d^2 (non-negative, as real samples are).
+std::vector<double> synthetic(pcg32& r, int n, double p0, double k, double h, double d) {
+  std::vector<double> y;
+  for (int i = 0; i < n; i++) {
+    if (unif(r) < p0) y.push_back(0);
+    else y.push_back(std::fabs(k + std::sqrt(h) * normal(r)) / (d * d));
+  }
+  return y;
+}
+
+// A floor lit by `lamps` small lamps of different radiance and height (plus a sun), and everything a sampler needs.
+struct test_scene {
+  scene_data scene;
+  bvh_data bvh;
+  light_data lights;
+  light_tree_data tree;
+  render_inputs in;
+};
+std::unique_ptr<test_scene> make_scene(int lamps, bool sun) {
+  mesh_builder b;
+  int floor = b.add_material({0.5f, 0.5f, 0.5f});
+  b.add_quad({-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, floor);
+  for (int i = 0; i < lamps; i++) {
+    float le = std::pow(10.0f, float(i % 5) - 2);
+    int m = b.add_material({0, 0, 0}, {le, le, le});
+    float x = -6 + 12 * float(i) / float(std::max(1, lamps - 1)), y = 1 + float(i % 3), z = float(i % 4) - 1.5f;
+    b.add_quad({x, y, z}, {x + 0.3f, y, z}, {x + 0.3f, y, z + 0.3f}, {x, y, z + 0.3f}, m);
+  }
+  auto t = std::make_unique<test_scene>();
+  camera_params cam;
+  cam.automatic = false;
+  cam.eye = {0, 8, 8};
+  cam.target = {0, 0, 0};
+  cam.fov_y_deg = 60;
+  sun_params sp;
+  if (sun) {
+    sp.enabled = true;
+    sp.direction = normalize(vec3f{-0.4f, 1, 0.3f});
+    sp.irradiance = {2, 2, 2};
+  }
+  t->scene = build_scene(std::move(b.mesh), cam, sp, false, 1.0f);
+  t->bvh = build_bvh(t->scene);
+  t->lights = build_lights(t->scene);
+  t->tree = build_light_tree(t->lights, t->scene);
+  t->in.scene = &t->scene;
+  t->in.bvh = &t->bvh;
+  t->in.lights = &t->lights;
+  t->in.camera = make_camera(t->scene.camera, 8, 8);
+  t->in.max_depth = 1;
+  return t;
+}
+
+// First hit of the centre ray of pixel (x, y): a point whose fine region exists from the start.
+shade_point pixel_point(const test_scene& t, int x, int y) {
+  vec3f dir = camera_ray_dir(t.in.camera, float(x) + 0.5f, float(y) + 0.5f);
+  hit_info h = intersect(t.bvh, t.in.camera.eye, dir);
+  REQUIRE(h.tri != invalid_id);
+  surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, dir);
+  return shade_point{sp.p, sp.ng, 0.5f, y * t.in.camera.width + x, 1};
+}
+
+}  // namespace
+
+TEST_CASE("the reference posterior weight is the conjugate Normal inverse gamma and Beta posterior", "[bayes]") {
+  pcg32 rng(31, 1);
+  struct data_case {
+    int n;
+    double p0, k, h, d;
+  };
+  const data_case cases[] = {{0, 0, 1, 1, 1},        {5, 1.0, 1, 1, 2},      {1, 0, 3, 1, 0.5},
+                             {7, 0.3, 0.5, 0.1, 2},  {200, 0.5, 10, 4, 0.1}, {1000, 0.05, 2e-4, 1e-9, 30},
+                             {50, 0.9, 5e5, 1e10, 1}};
+  for (const bayes_params& p : param_sets())
+    for (const data_case& dc : cases) {
+      std::vector<double> y = synthetic(rng, dc.n, dc.p0, dc.k, dc.h, dc.d);
+      std::vector<double> z;
+      for (double v : y) z.push_back(v * dc.d * dc.d);
+      moments m = exact_moments(z);
+      for (double bound : {1e-3, 0.7, 40.0}) {
+        double scale = 0.15;
+        INFO("n " << dc.n << " p0 " << dc.p0 << " d " << dc.d << " bound " << bound << " alpha0 " << p.alpha0);
+        double w = posterior_weight(p, bound, scale, dc.d, m.n0, m.n1, m.mean, m.m2);
+        long double ref = hand_posterior(p, bound, scale, dc.d, y);
+        CHECK(rel_err(w, double(ref)) < 1e-9);
+        bayes_params mo = p;
+        mo.second_moment = false;
+        CHECK(rel_err(posterior_weight(mo, bound, scale, dc.d, m.n0, m.n1, m.mean, m.m2),
+                      double(hand_posterior(p, bound, scale, dc.d, y, false))) < 1e-9);
+        // No prior: the naive plug-in moments.
+        bayes_params np = p;
+        np.prior = false;
+        double naive = posterior_weight(np, bound, scale, dc.d, m.n0, m.n1, m.mean, m.m2);
+        long double naive_ref = hand_naive(bound, scale, dc.d, y, true);
+        if (naive_ref == 0) CHECK(naive == 0);
+        else CHECK(rel_err(naive, double(naive_ref)) < 1e-9);
+        np.second_moment = false;
+        double naive_mean = posterior_weight(np, bound, scale, dc.d, m.n0, m.n1, m.mean, m.m2);
+        long double naive_mean_ref = hand_naive(bound, scale, dc.d, y, false);
+        if (naive_mean_ref == 0) CHECK(naive_mean == 0);
+        else CHECK(rel_err(naive_mean, double(naive_mean_ref)) < 1e-9);
+        // With the prior, every cluster with a non-zero bound keeps a finite positive weight.
+        CHECK(std::isfinite(w));
+        CHECK(w > 0);
+      }
+      CHECK(posterior_weight(p, 0.0, 0.15, dc.d, m.n0, m.n1, m.mean, m.m2) == 0);
+    }
+}
+
+TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes]") {
+  // Random statistics over many orders of magnitude, merged through rows; eval_weight (float coefficients)
+  // must agree with posterior_weight (double) to 1e-5 relative for random v = scale * bound and g = 1 / d^2.
+  pcg32 rng(37, 2);
+  std::vector<bayes_params> sets = param_sets();
+  bayes_params mo;
+  mo.second_moment = false;
+  bayes_params np;
+  np.prior = false;
+  bayes_params npm = np;
+  npm.second_moment = false;
+  sets.push_back(mo);
+  sets.push_back(np);
+  sets.push_back(npm);
+  for (const bayes_params& p : sets) {
+    const int pairs = 300;
+    bayes_stats s;
+    resize_stats(s, pairs, p);
+    std::vector<bayes_row> rows(3);
+    for (int i = 0; i < pairs; i++) {
+      int n = i % 10 == 0 ? 0 : int(log_uniform(rng, 1, 3000));
+      double p0 = unif(rng), zs = log_uniform(rng, 1e-12, 1e12), cv = log_uniform(rng, 1e-3, 3);
+      for (int k = 0; k < n; k++) {
+        double z = unif(rng) < p0 ? 0.0 : zs * std::fabs(1 + cv * normal(rng));
+        rows[size_t(rng(3))].add(i, z);
+      }
+    }
+    merge_rows(s, rows, p);
+    int worst_pair = -1;
+    double worst = 0;
+    for (int i = 0; i < pairs; i++)
+      for (int k = 0; k < 20; k++) {
+        double bound = log_uniform(rng, 1e-8, 1e8), scale = log_uniform(rng, 0.01, 1), d = log_uniform(rng, 1e-3, 1e3);
+        double v = scale * bound, g = 1 / (d * d);
+        double fast = eval_weight(s, size_t(i), p, s.p1[size_t(i)], v, g);
+        double ref = posterior_weight(p, bound, scale, d, s.n0[size_t(i)], s.n1[size_t(i)], s.mean[size_t(i)],
+                                      s.m2[size_t(i)]);
+        double e = ref == 0 ? std::fabs(fast) : rel_err(fast, ref);
+        if (e > worst) worst = e, worst_pair = i;
+      }
+    INFO("prior " << p.prior << " second moment " << p.second_moment << " alpha0 " << p.alpha0 << ": worst pair "
+                  << worst_pair << " n0 " << s.n0[size_t(worst_pair)] << " n1 " << s.n1[size_t(worst_pair)]
+                  << " mean " << s.mean[size_t(worst_pair)] << " m2 " << s.m2[size_t(worst_pair)]);
+    CHECK(worst < 1e-5);
+  }
+}
+
+TEST_CASE("prior only weights are proportional to the bound", "[bayes]") {
+  for (const bayes_params& p : param_sets()) {
+    bayes_stats s;
+    resize_stats(s, 5, p);
+    pcg32 rng(41, 3);
+    double ratio = eval_weight(s, 0, p, s.p1[0], 1.0, 1.0);
+    CHECK(ratio > 0);
+    for (int k = 0; k < 200; k++) {
+      double v = log_uniform(rng, 1e-10, 1e10), g = log_uniform(rng, 1e-6, 1e6);
+      CHECK(rel_err(eval_weight(s, size_t(k % 5), p, s.p1[size_t(k % 5)], v, g), ratio * v) < 1e-12);
+      double d = 1 / std::sqrt(g);
+      CHECK(rel_err(posterior_weight(p, v, 1.0, d, 0, 0, 0, 0), ratio * v) < 1e-6);  // float coefficient
+    }
+    CHECK(eval_weight(s, 0, p, s.p1[0], 0.0, 1.0) == 0);
+  }
+}
+
+TEST_CASE("a bayes sampler without data picks clusters like the bound sampler", "[bayes]") {
+  // Same regions and cuts; the prior-only weights are a constant times the bounds, so cluster probabilities agree
+  // to float precision (bounds are products in float in one and in double in the other, cdfs are float).
+  for (bool sun : {true, false}) {
+    auto t = make_scene(12, sun);
+    sampler_params pb;
+    pb.kind = sampler_kind::bound;
+    pb.regions.max_cut = 5;
+    sampler_params py = pb;
+    py.kind = sampler_kind::bayes;
+    light_sampler lb = make_light_sampler(pb, t->in, t->tree), ly = make_light_sampler(py, t->in, t->tree);
+    const bound_sampler& sb = std::get<bound_sampler>(lb);
+    const bayes_sampler& sy = std::get<bayes_sampler>(ly);
+    auto cb = std::make_unique<cut_context>(), cy = std::make_unique<cut_context>();
+    pcg32 rng(43, 4);
+    int compared = 0;
+    double worst = 0;
+    for (int k = 0; k < 400; k++) {
+      vec3f p = {float(-9 + 18 * unif(rng)), 0, float(-9 + 18 * unif(rng))};
+      shade_point sp{p, {0, 1, 0}, float(0.1 + 0.8 * unif(rng)), 0, 1};
+      sb.prepare(*cb, sp);
+      sy.prepare(*cy, sp);
+      REQUIRE(cb->count == cy->count);
+      for (int l = 0; l < t->lights.count; l++) {
+        double a = sb.pmf(*cb, l), b = sy.pmf(*cy, l);
+        worst = std::max(worst, std::fabs(a - b) / (1e-5 * a + 3e-7));
+        compared++;
+      }
+    }
+    INFO("sun " << sun << ": " << compared << " light pmfs compared, worst |diff| / (1e-5 pmf + 3e-7) " << worst);
+    CHECK(worst <= 1);
+  }
+}
+
+TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]") {
+  pcg32 rng(47, 5);
+  bayes_params p;
+  const int pairs = 40;
+  // Observations per pair: zeros and log-normal values around different scales.
+  std::vector<std::vector<double>> obs(pairs);
+  std::vector<std::pair<int, double>> stream;
+  for (int i = 0; i < pairs; i++) {
+    double scale = log_uniform(rng, 1e-3, 1e3);
+    int n = 1 + int(rng(400));
+    for (int k = 0; k < n; k++) {
+      double z = unif(rng) < 0.3 ? 0.0 : scale * std::exp(0.5 * normal(rng));
+      obs[size_t(i)].push_back(z);
+    }
+  }
+  // Interleave the pairs' observations in a random order (as NEE events of many pixels would).
+  std::vector<size_t> next(pairs, 0);
+  for (bool left = true; left;) {
+    left = false;
+    for (int i = 0; i < pairs; i++) {
+      int burst = int(rng(4));
+      for (int b = 0; b < burst && next[size_t(i)] < obs[size_t(i)].size(); b++)
+        stream.push_back({i, obs[size_t(i)][next[size_t(i)]++]});
+      left = left || next[size_t(i)] < obs[size_t(i)].size();
+    }
+  }
+  // Reference: one-pass Welford in the stream order, and a two-pass long double computation.
+  std::vector<moments> welford(pairs);
+  for (auto [i, z] : stream) {
+    moments& m = welford[size_t(i)];
+    if (z == 0) {
+      m.n0 += 1;
+      continue;
+    }
+    m.n1 += 1;
+    double delta = z - m.mean;
+    m.mean += delta / m.n1;
+    m.m2 += delta * (z - m.mean);
+  }
+  // Groupings: everything in one row; one row per observation; random chunks merged over several passes.
+  for (int grouping = 0; grouping < 3; grouping++) {
+    bayes_stats s;
+    resize_stats(s, pairs, p);
+    if (grouping == 0) {
+      std::vector<bayes_row> rows(1);
+      for (auto [i, z] : stream) rows[0].add(i, z);
+      merge_rows(s, rows, p);
+    } else if (grouping == 1) {
+      std::vector<bayes_row> rows(stream.size());
+      for (size_t k = 0; k < stream.size(); k++) rows[k].add(stream[k].first, stream[k].second);
+      merge_rows(s, rows, p);
+    } else {
+      size_t k = 0;
+      for (int pass = 0; pass < 4; pass++) {
+        std::vector<bayes_row> rows(7);
+        size_t end = pass == 3 ? stream.size() : stream.size() * size_t(pass + 1) / 4;
+        for (; k < end; k++) rows[size_t(rng(7))].add(stream[k].first, stream[k].second);
+        for (bayes_row& r : rows) {
+          // Reused rows must start empty after clear().
+          bayes_row copy = r;
+          copy.clear();
+          CHECK(copy.acc.empty());
+        }
+        merge_rows(s, rows, p);
+      }
+    }
+    for (int i = 0; i < pairs; i++) {
+      INFO("grouping " << grouping << " pair " << i);
+      moments ex = exact_moments(obs[size_t(i)]);
+      CHECK(s.n0[size_t(i)] == ex.n0);
+      CHECK(s.n1[size_t(i)] == ex.n1);
+      CHECK(rel_err(s.mean[size_t(i)], welford[size_t(i)].mean) <= 1e-12);
+      CHECK(rel_err(s.m2[size_t(i)], welford[size_t(i)].m2) <= 1e-12);
+      CHECK(rel_err(s.mean[size_t(i)], ex.mean) <= 1e-12);
+      CHECK(rel_err(s.m2[size_t(i)], ex.m2) <= 1e-12);
+      // The coefficients were refreshed from the merged statistics.
+      double ref = posterior_weight(p, 2.0, 0.3, 1.5, s.n0[size_t(i)], s.n1[size_t(i)], s.mean[size_t(i)],
+                                    s.m2[size_t(i)]);
+      CHECK(rel_err(eval_weight(s, size_t(i), p, s.p1[size_t(i)], 0.6, 1 / 2.25), ref) < 1e-5);
+    }
+  }
+}
+
+TEST_CASE("decaying statistics scales the counts and keeps the mean", "[bayes]") {
+  bayes_params p;
+  bayes_stats s;
+  resize_stats(s, 2, p);
+  std::vector<bayes_row> rows(1);
+  for (double z : {0.0, 1.0, 2.0, 0.0, 4.0}) rows[0].add(1, z);
+  merge_rows(s, rows, p);
+  double mean = s.mean[1], m2 = s.m2[1];
+  decay_stats(s, 0.5, p);
+  CHECK(s.n0[1] == 1.0);
+  CHECK(s.n1[1] == 1.5);
+  CHECK(s.mean[1] == mean);
+  CHECK(s.m2[1] == 0.5 * m2);
+  CHECK(rel_err(eval_weight(s, 1, p, s.p1[1], 0.2, 0.5), posterior_weight(p, 0.2, 1.0, std::sqrt(2.0), 1.0, 1.5, mean, 0.5 * m2)) <
+        1e-5);
+}
+
+namespace {
+
+// A region of 3 clusters fed with synthetic observations at one point. Cluster j: Y = 0 with probability p0[j],
+// else |N(k_j, h_j)| / d_j^2 with k_j = factor[j] * mu0_j (mu0_j the prior mean the bound gives) and
+// sqrt(h_j) = cv[j] k_j <= k_j / 5 (negative draws have probability < 3e-7; folding them changes nothing visible).
+// With all observations at one point the ideal pmf is proportional to sqrt(E[Y^2]) = sqrt((1 - p0)(k^2 + h)) / d^2
+// (mean-only ablation: E[Y] = (1 - p0) k / d^2), whatever the distance-regression switch.
+struct convergence_setup {
+  double p0[3], factor[3], cv[3];
+};
+
+struct convergence_result {
+  double learned[3], target[3], prior[3];
+  double tolerance;          // on |learned / target - 1|, see below
+  double mean_error = 0;     // worst relative error of the stored means against the recorded z
+};
+
+convergence_result run_convergence(const bayes_params& params, const convergence_setup& cs, int n, uint64_t seed) {
+  auto t = make_scene(3, false);  // 3 lamps: every region shares one cut of the 3 leaves
+  sampler_params sp;
+  sp.kind = sampler_kind::bayes;
+  sp.bayes = params;
+  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+  bayes_sampler& s = std::get<bayes_sampler>(ls);
+  shade_point pt = pixel_point(*t, 4, 4);
+  auto ctx = std::make_unique<cut_context>();
+  s.prepare(*ctx, pt);
+  REQUIRE(ctx->count == 3);
+  REQUIRE(s.regions.key[size_t(ctx->region)] == ctx->fine_key);  // the point's own fine region
+  convergence_result r;
+  double scale = pt.albedo * inv_pi_f;
+  double d[3], k[3], h[3], dist[3];
+  for (int j = 0; j < 3; j++) {
+    r.prior[j] = cluster_pmf(*ctx, j);
+    float inv_d2;
+    float num = cluster_bound_parts(t->tree, t->lights, ctx->nodes[j], pt.p, pt.n, 0, 1, inv_d2);
+    double bound = double(num) * inv_d2;
+    dist[j] = cluster_distance(t->tree, ctx->nodes[j], pt.p);
+    d[j] = dist[j];
+    double mu0 = scale * bound * d[j] * d[j];  // prior mean of z = Y d^2
+    k[j] = cs.factor[j] * mu0;
+    h[j] = cs.cv[j] * cs.cv[j] * k[j] * k[j];
+  }
+  // Feed n observations per cluster over 6 passes of 4 rows.
+  pcg32 rng(seed, 6);
+  size_t base = size_t(s.regions.pair_offset[size_t(ctx->region)]);
+  std::vector<long double> zsum(3, 0.0L);
+  std::vector<double> zcount(3, 0.0);
+  for (int pass = 0; pass < 6; pass++) {
+    std::vector<bayes_row> rows(4);
+    for (int i = pass * n / 6; i < (pass + 1) * n / 6; i++)
+      for (int j = 0; j < 3; j++) {
+        float y = 0;
+        if (!(unif(rng) < cs.p0[j])) y = float(std::fabs(k[j] + std::sqrt(h[j]) * normal(rng)) / (d[j] * d[j]));
+        light_choice c;
+        c.cluster = j;
+        c.light = j;
+        s.record(rows[size_t(i % 4)], nee_event<cut_context>{ctx.get(), c, y});
+        if (y > 0) {
+          // What the statistics must hold: z = Y d^2 with the regression, z = Y without.
+          double z = params.distance_regression ? double(y) * dist[j] * dist[j] : double(y);
+          zsum[size_t(j)] += z;
+          zcount[size_t(j)] += 1;
+        }
+      }
+    s.learn(rows);
+  }
+  for (int j = 0; j < 3; j++)
+    r.mean_error = std::max(r.mean_error, rel_err(s.stats.mean[base + size_t(j)], double(zsum[size_t(j)] / zcount[size_t(j)])));
+  s.prepare(*ctx, pt);
+  double total = 0, sigma = 0, bias = 0;
+  for (int j = 0; j < 3; j++) {
+    r.learned[j] = cluster_pmf(*ctx, j);
+    double p1 = 1 - cs.p0[j], k2 = k[j] * k[j], hh = h[j];
+    double ez2 = k2 + hh, ez4 = k2 * k2 + 6 * k2 * hh + 3 * hh * hh;  // moments of z given non-zero
+    double f = cs.factor[j], n1 = n * p1;
+    if (params.second_moment) {
+      r.target[j] = std::sqrt(p1 * ez2) / (d[j] * d[j]);
+      // w^2 estimates E[Z^2], Z = z 1{non-zero}: relative sd of w = sd(Z^2) / E[Z^2] / (2 sqrt(n)).
+      sigma = std::max(sigma, 0.5 * std::sqrt((ez4 / (p1 * ez2 * ez2) - 1) / n));
+    } else {
+      r.target[j] = p1 * k[j] / (d[j] * d[j]);
+      sigma = std::max(sigma, std::sqrt((ez2 / (p1 * k2) - 1) / n));
+    }
+    // Pull of the prior, relative, of order 1 / n1 (see METHOD.md 4): Beta pseudo-counts, kappa0 on the mean,
+    // beta0 and the (z - mu0)^2 term on the variance.
+    double pull = (params.a0 + params.b0 + 2 * params.kappa0 * std::max(1.0, 1 / f) +
+                   2 * (params.c * (params.alpha0 - 1) / (f * f) + params.kappa0 * (1 + 1 / f) * (1 + 1 / f) +
+                        (params.alpha0 - 1))) / n1;
+    bias = std::max(bias, params.prior ? pull : 0.0);
+    total += r.target[j];
+  }
+  for (int j = 0; j < 3; j++) r.target[j] /= total;
+  // 5 standard deviations per cluster (two-sided 5.7e-7 each, < 2e-6 for the three) plus the prior's pull;
+  // normalising can double a relative error.
+  r.tolerance = 2 * (5 * sigma + bias);
+  return r;
+}
+
+void check_convergence(const convergence_result& r, double epsilon) {
+  double prior_gap = 0;
+  for (int j = 0; j < 3; j++) {
+    double target = (1 - epsilon) * r.target[j] + epsilon * r.prior[j];
+    INFO("cluster " << j << " learned " << r.learned[j] << " target " << target << " prior " << r.prior[j]
+                    << " tolerance " << r.tolerance);
+    CHECK(std::fabs(r.learned[j] / target - 1) <= r.tolerance);
+    prior_gap = std::max(prior_gap, std::fabs(r.prior[j] / target - 1));
+  }
+  // Decisive: the prior-only pmf is far outside the tolerance, so only learning can have brought it there.
+  CHECK(prior_gap > 3 * r.tolerance);
+  CHECK(r.mean_error < 1e-12);
+}
+
+const convergence_setup setup = {{0.2, 0.6, 0.9}, {0.5, 2.0, 1.0}, {0.2, 0.1, 0.15}};
+
+}  // namespace
+
+TEST_CASE("a learned pmf converges to the square root of the second moment", "[bayes]") {
+  for (const bayes_params& p : param_sets()) {
+    INFO("alpha0 " << p.alpha0 << " kappa0 " << p.kappa0);
+    check_convergence(run_convergence(p, setup, 60000, 51), 0.0);
+  }
+}
+
+TEST_CASE("the bayes ablations learn what their definitions say", "[bayes]") {
+  SECTION("mean only: the pmf follows the posterior mean over d^2") {
+    bayes_params p;
+    p.second_moment = false;
+    check_convergence(run_convergence(p, setup, 60000, 53), 0.0);
+  }
+  SECTION("no prior: plug-in moments mixed with 1e-3 of the bound pmf") {
+    bayes_params p;
+    p.prior = false;
+    check_convergence(run_convergence(p, setup, 60000, 55), 1e-3);
+  }
+  SECTION("no distance regression: the statistics pool Y itself") {
+    bayes_params p;
+    p.distance_regression = false;
+    check_convergence(run_convergence(p, setup, 60000, 57), 0.0);
+  }
+}
+
+TEST_CASE("the naive ablation follows plug in moments exactly", "[bayes]") {
+  // After a handful of observations the no-prior pmf is the definition: (1 - eps) w / sum w + eps b / sum b with
+  // w = sqrt(n1/n (mean^2 + m2/n1)) / d^2 (or the bound when a pair has no data) and eps = 1e-3.
+  auto t = make_scene(3, false);
+  sampler_params sp;
+  sp.kind = sampler_kind::bayes;
+  sp.bayes.prior = false;
+  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+  bayes_sampler& s = std::get<bayes_sampler>(ls);
+  shade_point pt = pixel_point(*t, 4, 4);
+  auto ctx = std::make_unique<cut_context>();
+  s.prepare(*ctx, pt);
+  REQUIRE(ctx->count == 3);
+  double bound_pmf[3];
+  for (int j = 0; j < 3; j++) bound_pmf[j] = cluster_pmf(*ctx, j);
+  std::vector<bayes_row> rows(1);
+  const float ys[2][4] = {{0, 0.5f, 0.25f, 0}, {0, 0, 0, 0}};  // cluster 2 gets nothing
+  for (int j = 0; j < 2; j++)
+    for (float y : ys[j]) {
+      light_choice c;
+      c.cluster = j;
+      s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
+    }
+  s.learn(rows);
+  s.prepare(*ctx, pt);
+  double w[3], b[3], sw = 0, sb = 0;
+  double scale = pt.albedo * inv_pi_f;
+  for (int j = 0; j < 3; j++) {
+    float inv_d2;
+    float num = cluster_bound_parts(t->tree, t->lights, ctx->nodes[j], pt.p, pt.n, 0, 1, inv_d2);
+    b[j] = double(num) * inv_d2;
+    double d = cluster_distance(t->tree, ctx->nodes[j], pt.p);
+    if (j == 0) {
+      std::vector<double> z = {0.5 * d * d, 0.25 * d * d};
+      double mean = (z[0] + z[1]) / 2, var = ((z[0] - mean) * (z[0] - mean) + (z[1] - mean) * (z[1] - mean)) / 2;
+      w[j] = std::sqrt(0.5 * (mean * mean + var)) / (d * d);
+    } else if (j == 1) {
+      w[j] = 0;  // only zeros: the naive estimate starves the cluster (the mixing keeps it alive)
+    } else {
+      w[j] = scale * b[j];
+    }
+    sw += w[j];
+    sb += b[j];
+  }
+  for (int j = 0; j < 3; j++) {
+    double expect = (1 - 1e-3) * w[j] / sw + 1e-3 * b[j] / sb;
+    INFO("cluster " << j << " bound pmf " << bound_pmf[j]);
+    CHECK(cluster_pmf(*ctx, j) == Approx(expect).epsilon(1e-5).margin(3e-7));
+    CHECK(cluster_pmf(*ctx, j) > 0);
+  }
+}
+
+TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[bayes]") {
+  // A fine pair's Beta prior on p0 is centred on its coarse parent's posterior mean with concentration s:
+  // E[1 - p0] = (s p1_parent + n1) / (s + n), p1_parent = (b0 + n1_parent) / (a0 + b0 + n_parent); the rest of the
+  // posterior (k, h) is the fine pair's own. Every observation of the fine pair also counts for the parent pair.
+  for (bool second_moment : {true, false}) {
+    INFO("second moment " << second_moment);
+    auto t = make_scene(3, false);
+    sampler_params sp;
+    sp.kind = sampler_kind::bayes;
+    sp.bayes.second_moment = second_moment;
+    REQUIRE(sp.bayes.hierarchy > 0);
+    light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+    bayes_sampler& s = std::get<bayes_sampler>(ls);
+    shade_point pt = pixel_point(*t, 4, 4);
+    auto ctx = std::make_unique<cut_context>();
+    s.prepare(*ctx, pt);
+    REQUIRE(ctx->count == 3);
+    int fine = ctx->region;
+    REQUIRE(s.regions.key[size_t(fine)] == ctx->fine_key);
+    int coarse = s.regions.parent[size_t(fine)];
+    REQUIRE(coarse != invalid_id);
+    size_t base = size_t(s.regions.pair_offset[size_t(fine)]);
+    // Observations at the point: cluster 0 gets 5 non-zero and 3 zero samples, cluster 1 only zeros.
+    std::vector<bayes_row> rows(1);
+    const float ys[2][8] = {{0.2f, 0, 0.3f, 0.25f, 0, 0.5f, 0.1f, 0}, {0, 0, 0, 0, 0, 0, 0, 0}};
+    for (int j = 0; j < 2; j++)
+      for (float y : ys[j]) {
+        light_choice c;
+        c.cluster = j;
+        s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
+      }
+    s.learn(rows);
+    for (int j = 0; j < 3; j++) {
+      size_t i = base + size_t(j);
+      int up = s.regions.pair_parent[i];
+      REQUIRE(up == s.regions.pair_offset[size_t(coarse)] + j);
+      CHECK(s.stats.n0[size_t(up)] == s.stats.n0[i]);
+      CHECK(s.stats.n1[size_t(up)] == s.stats.n1[i]);
+      CHECK(s.stats.mean[size_t(up)] == s.stats.mean[i]);
+      CHECK(s.stats.m2[size_t(up)] == s.stats.m2[i]);
+    }
+    // More observations of cluster 0 reach only the parent: its posterior now differs from the fine pair's.
+    std::vector<bayes_row> more(1);
+    for (int k = 0; k < 6; k++) more[0].add(s.regions.pair_offset[size_t(coarse)], 3.0 + k);
+    merge_rows(s.stats, more, s.params);
+    s.prepare(*ctx, pt);
+    double w[3], own[3], sw = 0, sown = 0;
+    double scale = pt.albedo * inv_pi_f;
+    for (int j = 0; j < 3; j++) {
+      size_t i = base + size_t(j), up = size_t(s.regions.pair_parent[i]);
+      float inv_d2;
+      float num = cluster_bound_parts(t->tree, t->lights, ctx->nodes[j], pt.p, pt.n, 0, 1, inv_d2);
+      double bound = double(num) * inv_d2;
+      double d = 1 / std::sqrt(double(inv_d2));
+      double wf = posterior_weight(s.params, bound, scale, d, s.stats.n0[i], s.stats.n1[i], s.stats.mean[i],
+                                   s.stats.m2[i]);
+      double wp = posterior_weight(s.params, bound, scale, d, s.stats.n0[up], s.stats.n1[up], s.stats.mean[up],
+                                   s.stats.m2[up]);
+      const bayes_params& bp = s.params;
+      double n = s.stats.n0[i] + s.stats.n1[i], np = s.stats.n0[up] + s.stats.n1[up];
+      double p1_own = (bp.b0 + s.stats.n1[i]) / (bp.a0 + bp.b0 + n);
+      double p1_parent = (bp.b0 + s.stats.n1[up]) / (bp.a0 + bp.b0 + np);
+      double p1_h = (bp.hierarchy * p1_parent + s.stats.n1[i]) / (bp.hierarchy + n);
+      w[j] = second_moment ? wf * std::sqrt(p1_h / p1_own) : wf * (p1_h / p1_own);
+      own[j] = wf;
+      (void)wp;
+      sw += w[j];
+      sown += wf;
+    }
+    double gap = 0;
+    for (int j = 0; j < 3; j++) {
+      INFO("cluster " << j);
+      CHECK(cluster_pmf(*ctx, j) == Approx(w[j] / sw).epsilon(1e-5).margin(3e-7));
+      gap = std::max(gap, std::fabs(w[j] / sw - own[j] / sown) / (own[j] / sown));
+    }
+    INFO("largest relative move of a cluster probability due to the parent " << gap);
+    CHECK(gap > 1e-2);  // decisive: the parent's extra data visibly moves the blend away from the fine posterior
+  }
+}
+
