@@ -25,9 +25,8 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   double sum_w = 0, sum_b = 0;
   for (int j = 0; j < ctx.count; j++) {
     double bound = double(num[j]) * inv_d2[j];
-    size_t i = base + size_t(j);
     double g = params.distance_regression ? inv_d2[j] : 1.0;
-    w[j] = eval_weight(stats, i, params, pair_p1(stats, i, regions.pair_parent[i], params), scale * bound, g);
+    w[j] = eval_weight(stats.weight[base + size_t(j)], params, scale * bound, g);
     b[j] = bound;
     sum_w += w[j];
     sum_b += b[j];
@@ -50,18 +49,17 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
     double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
     z *= d * d;
   }
-  size_t i = size_t(regions.pair_offset[size_t(ctx.region)] + j);
-  row.add(int(i), z);
-  int up = regions.pair_parent[i];
-  if (up != invalid_id && params.hierarchy > 0) row.add(up, z);
+  row.add(regions.pair_offset[size_t(ctx.region)] + j, z);
 }
 
 void bayes_sampler::learn(std::vector<row_state>& rows) {
-  merge_rows(stats, rows, params);
+  merge_rows(stats, rows, params, params.hierarchy > 0 ? &regions.pair_parent : nullptr);
   std::vector<const region_requests*> r;
   for (const row_state& row : rows) r.push_back(&row.requests);
   create_requested_regions(regions, *tree, r);
   resize_stats(stats, regions.pairs, params);
+  // Fold each pair's (hierarchical) p1 into its sampling weight: one sequential sweep over the pairs.
+  refresh_weights(stats, &regions.pair_parent, params);
 }
 
 }  // namespace bl

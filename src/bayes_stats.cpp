@@ -14,20 +14,15 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   s.n1.resize(n, 0.0);
   s.mean.resize(n, 0.0);
   s.m2.resize(n, 0.0);
-  s.q2.resize(n);
-  s.q1.resize(n);
-  s.q0.resize(n);
-  s.qc.resize(n);
-  s.p1.resize(n);
+  s.coeffs.resize(n);
+  s.weight.resize(n);
   if (n > old) {
-    // All empty pairs share the prior-only coefficients.
+    // All empty pairs share the prior-only coefficients (and, without data anywhere, the same weight).
     update_coeffs(s, old, p);
+    fold_weight(s, old, invalid_id, p);
     for (size_t i = old + 1; i < n; i++) {
-      s.q2[i] = s.q2[old];
-      s.q1[i] = s.q1[old];
-      s.q0[i] = s.q0[old];
-      s.qc[i] = s.qc[old];
-      s.p1[i] = s.p1[old];
+      s.coeffs[i] = s.coeffs[old];
+      s.weight[i] = s.weight[old];
     }
   }
 }
@@ -73,11 +68,7 @@ void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
       qc = c;
     }
   }
-  s.p1[i] = float(p1);
-  s.q2[i] = float(q2);
-  s.q1[i] = float(q1);
-  s.q0[i] = float(q0);
-  s.qc[i] = float(qc);
+  s.coeffs[i] = {float(q2), float(q1), float(q0), float(qc), float(p1)};
 }
 
 void bayes_row::clear() {
@@ -119,22 +110,38 @@ void bayes_row::add(int pair, double z) {
   a.m2 += delta * (z - a.mean);
 }
 
-void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p) {
+void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p) {
+  for (size_t i = 0; i < s.weight.size(); i++) fold_weight(s, i, parents ? (*parents)[i] : invalid_id, p);
+}
+
+// Chan's parallel update of pair i with an accumulator.
+static void merge_accum(bayes_stats& s, size_t i, const pair_accum& a) {
+  s.n0[i] += a.n0;
+  if (a.n1 > 0) {
+    double n = s.n1[i] + a.n1;
+    double delta = a.mean - s.mean[i];
+    s.mean[i] += delta * (a.n1 / n);
+    s.m2[i] += a.m2 + delta * delta * (s.n1[i] * a.n1 / n);
+    s.n1[i] = n;
+  }
+}
+
+void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
+                const std::vector<int>* parents) {
+  auto parent_of = [parents](int pair) { return parents ? (*parents)[size_t(pair)] : invalid_id; };
   for (const bayes_row& row : rows)
     for (const pair_accum& a : row.acc) {
-      size_t i = size_t(a.pair);
-      s.n0[i] += a.n0;
-      if (a.n1 > 0) {
-        double n = s.n1[i] + a.n1;
-        double delta = a.mean - s.mean[i];
-        s.mean[i] += delta * (a.n1 / n);
-        s.m2[i] += a.m2 + delta * delta * (s.n1[i] * a.n1 / n);
-        s.n1[i] = n;
-      }
+      merge_accum(s, size_t(a.pair), a);
+      int up = parent_of(a.pair);
+      if (up != invalid_id) merge_accum(s, size_t(up), a);
     }
   // Coefficients once per touched pair (a pair may appear in many rows; recomputing is idempotent).
   for (const bayes_row& row : rows)
-    for (const pair_accum& a : row.acc) update_coeffs(s, size_t(a.pair), p);
+    for (const pair_accum& a : row.acc) {
+      update_coeffs(s, size_t(a.pair), p);
+      int up = parent_of(a.pair);
+      if (up != invalid_id) update_coeffs(s, size_t(up), p);
+    }
 }
 
 double posterior_weight(const bayes_params& p, double bound, double scale, double d, double n0, double n1,

@@ -36,33 +36,51 @@ struct bayes_params {
 //   w = sqrt(p1 * max(q2 v^2 + q1 v g + q0 g^2, qc v^2))      (qc v^2 = the prior-variance term, a lower bound)
 // and for the mean-only ablation w = p1 (q2 v + q1 g). p1 = E[1 - p0]: the pair's own posterior mean under
 // Beta(a0, b0), or for a fine pair under the hierarchical prior Beta(s (1 - p1_parent), s p1_parent),
-// p1 = (s p1_parent + n1) / (s + n). Coefficients change only for pairs that got samples.
-struct bayes_stats {
-  std::vector<double> n0, n1, mean, m2;
-  std::vector<float> q2, q1, q0, qc;
-  std::vector<float> p1;  // posterior mean of 1 - p0 under Beta(a0, b0) (plug-in n1 / n for the naive ablation)
+// p1 = (s p1_parent + n1) / (s + n). Between passes p1 is folded into the coefficients (`weight`), so a shading
+// point reads 16 bytes per cluster and evaluates w = sqrt(max((w2 v + w1 g) v + w0 g^2, wc v^2)).
+struct pair_coeffs {
+  float q2, q1, q0, qc;  // the quadratic's coefficients (see above)
+  float p1;              // posterior mean of 1 - p0 under Beta(a0, b0) (plug-in n1 / n for the naive ablation)
+};
+// What sampling reads of one pair: the coefficients with the (hierarchical) p1 folded in.
+struct pair_weight {
+  float w2, w1, w0, wc;
 };
 
-// Grows the columns to `pairs` entries (new pairs start empty, with prior-only coefficients).
+struct bayes_stats {
+  std::vector<double> n0, n1, mean, m2;  // statistics: read and written between passes only
+  std::vector<pair_coeffs> coeffs;       // posterior per pair without the hierarchy (between passes only)
+  std::vector<pair_weight> weight;       // read by every shading point
+};
+
+// Grows the columns to `pairs` entries (new pairs start empty, with prior-only coefficients and weights).
 void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p);
 // Recomputes the coefficients of pair i from its statistics.
 void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p);
+// Scales all statistics by gamma (animation: the prior regains weight); coefficients are refreshed.
+void decay_stats(bayes_stats& s, double gamma, const bayes_params& p);
+
 // E[1 - p0] of pair i, under the hierarchical prior when `up` (its parent pair) is valid.
 inline double pair_p1(const bayes_stats& s, size_t i, int up, const bayes_params& p) {
-  if (up < 0 || !(p.hierarchy > 0) || !p.prior) return s.p1[i];
-  return (p.hierarchy * s.p1[size_t(up)] + s.n1[i]) / (p.hierarchy + s.n0[i] + s.n1[i]);
+  if (up < 0 || !(p.hierarchy > 0) || !p.prior) return s.coeffs[i].p1;
+  return (p.hierarchy * double(s.coeffs[size_t(up)].p1) + s.n1[i]) / (p.hierarchy + s.n0[i] + s.n1[i]);
 }
-// Weight of pair i with E[1 - p0] = p1 for a point with prior mean v (= scale * bound) and g = 1 / d^2;
-// 0 when v is 0.
-inline double eval_weight(const bayes_stats& s, size_t i, const bayes_params& p, double p1, double v, double g) {
+// Folds pair i's p1 into its sampling weight.
+inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
+  double p1 = pair_p1(s, i, up, p);
+  const pair_coeffs& c = s.coeffs[i];
+  s.weight[i] = {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
+}
+// Folds every pair's p1 into its weight (parents: region_state::pair_parent, or nullptr for none): the sweep
+// that ends learning between passes.
+void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p);
+// Weight of a pair for a point with prior mean v (= scale * bound) and g = 1 / d^2; 0 when v is 0.
+inline double eval_weight(const pair_weight& h, const bayes_params& p, double v, double g) {
   if (!(v > 0)) return 0;
-  if (!p.second_moment) return p1 * (double(s.q2[i]) * v + double(s.q1[i]) * g);
-  double val = (double(s.q2[i]) * v + double(s.q1[i]) * g) * v + double(s.q0[i]) * g * g;
-  return std::sqrt(p1 * std::max(val, double(s.qc[i]) * v * v));
+  if (!p.second_moment) return double(h.w2) * v + double(h.w1) * g;
+  double val = (double(h.w2) * v + double(h.w1) * g) * v + double(h.w0) * g * g;
+  return std::sqrt(std::max(val, double(h.wc) * v * v));
 }
-
-// Scales all statistics by gamma (animation: the prior regains weight).
-void decay_stats(bayes_stats& s, double gamma, const bayes_params& p);
 
 // One pair's statistics accumulated within one image row (Welford).
 struct pair_accum {
@@ -80,9 +98,11 @@ struct bayes_row {
   void add(int pair, double z);
 };
 
-// Folds the rows, in order, into the statistics (Chan's parallel update) and refreshes the coefficients of
-// the pairs they touched.
-void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p);
+// Folds the rows, in order, into the statistics (Chan's parallel update) — each accumulator into its pair and
+// into that pair's parent (`parents` = region_state::pair_parent, or nullptr for none) — and refreshes the
+// coefficients of the pairs touched. Weights are not refolded (see fold_weight).
+void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
+                const std::vector<int>* parents);
 
 // Reference form of the weight (the conjugate posterior written out, in double): sqrt((1 - p0)(k^2 + h)) / d^2
 // (or the ablations) from a pair's statistics and mu0 = scale * bound * d^2. eval_weight must agree with it.

@@ -179,8 +179,11 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--cut-coherence", o.regions.coherence,
                 "Keep a light cluster whole when its radius / gap to the region <= this (default 0.25; 0 = off)")
       ->check(CLI::Range(0.0, 100.0))->group(grp);
+  r->add_option("--region-min-samples", o.regions.min_samples,
+                "NEE samples a fine cell asks for before it gets its own region (default 16)")
+      ->check(CLI::Range(1, 1 << 30))->group(grp);
   r->add_option("--region-budget", o.regions.max_pairs,
-                "Most (region, cluster) pairs before coarser regions serve (default 8388608)")
+                "Most (region, cluster) pairs before coarser regions serve (default 1048576)")
       ->check(CLI::Range(int64_t(1), int64_t(1) << 40))->group(grp);
   const char* bg = "Bayesian sampler (bayes): prior strengths and ablations";
   r->add_option("--bayes-pmf", o.bayes_pmf, "second-moment (the paper) or mean (ablation: PMF from the mean only)")

@@ -11,8 +11,12 @@ void locate_region(cut_context& ctx, const region_state& regions, const shade_po
   ctx.p = sp.p;
   ctx.n = sp.n;
   ctx.albedo = sp.albedo;
-  ctx.fine_key = fine_region_key(regions.grid, sp.p);
-  ctx.region = find_region(regions, ctx.fine_key);
+  uint64_t key = fine_region_key(regions.grid, sp.p);
+  // Neighbouring samples often fall in the same cell: reuse the last lookup (regions are frozen during a pass).
+  if (key != ctx.fine_key) {
+    ctx.fine_key = key;
+    ctx.region = find_region(regions, key);
+  }
   ctx.count = regions.cut_size[size_t(ctx.region)];
   ctx.nodes = regions.cut_nodes.data() + regions.cut_offset[size_t(ctx.region)];
   ctx.tree_count = ctx.count - (regions.has_sun ? 1 : 0);
@@ -52,12 +56,15 @@ float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_d
 
 int create_requested_regions(region_state& regions, const light_tree_data& tree,
                              const std::vector<const region_requests*>& rows) {
-  std::vector<uint64_t> keys;
-  for (const region_requests* r : rows) keys.insert(keys.end(), r->keys.begin(), r->keys.end());
-  if (keys.empty()) return 0;
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  return add_regions(regions, tree, keys);
+  std::vector<uint64_t> ready;
+  for (const region_requests* r : rows)
+    for (size_t k = 0; k < r->keys.size(); k++)
+      if (add_pending(regions, r->keys[k], r->counts[k])) ready.push_back(r->keys[k]);
+  if (ready.empty()) return 0;
+  std::sort(ready.begin(), ready.end());
+  ready.erase(std::unique(ready.begin(), ready.end()), ready.end());
+  for (uint64_t key : ready) remove_pending(regions, key);
+  return add_regions(regions, tree, ready);
 }
 
 void sun_half_angle(const light_data& lights, float& sin_out, float& cos_out) {

@@ -22,7 +22,7 @@ constexpr int max_cut_entries = 1025;
 struct cut_context {
   vec3f p, n;
   float albedo = 0;
-  uint64_t fine_key = 0;
+  uint64_t fine_key = ~uint64_t(0);  // (no fine key yet: see locate_region's reuse of the last lookup)
   int region = 0;
   int count = 0;               // clusters in the cut
   int tree_count = 0;          // of which tree nodes (the sun, if any, is last)
@@ -66,16 +66,27 @@ light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, con
 // Probability that sample_cut picks `light`.
 float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, int light);
 
-// Fine region keys requested by one image row (shading points whose fine region does not exist yet).
+// Fine region keys requested by one image row (NEE events at points whose fine region does not exist yet), as
+// runs of (key, count).
 struct region_requests {
   std::vector<uint64_t> keys;
-  void clear() { keys.clear(); }
+  std::vector<uint32_t> counts;
+  void clear() {
+    keys.clear();
+    counts.clear();
+  }
   void add(const region_state& regions, const cut_context& ctx) {
-    if (regions.key[size_t(ctx.region)] != ctx.fine_key && (keys.empty() || keys.back() != ctx.fine_key))
-      keys.push_back(ctx.fine_key);
+    if (regions.key[size_t(ctx.region)] == ctx.fine_key) return;
+    if (!keys.empty() && keys.back() == ctx.fine_key) {
+      counts.back()++;
+      return;
+    }
+    keys.push_back(ctx.fine_key);
+    counts.push_back(1);
   }
 };
-// Creates the regions requested by all rows (sorted, deduplicated: independent of thread timing).
+// Adds the rows' requests to the pending counts and creates the fine regions whose count reached
+// region_params::min_samples, in key order (so the result does not depend on thread timing).
 int create_requested_regions(region_state& regions, const light_tree_data& tree,
                              const std::vector<const region_requests*>& rows);
 

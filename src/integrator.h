@@ -31,13 +31,14 @@ struct render_inputs {
 
 // Counters of one worker's share of a pass (summed in a fixed order afterwards).
 struct path_stats {
-  uint64_t camera_rays = 0, shadow_rays = 0, bounce_rays = 0, nee_samples = 0, bad_samples = 0;
+  uint64_t camera_rays = 0, shadow_rays = 0, bounce_rays = 0, nee_samples = 0, nee_zero = 0, bad_samples = 0;
 };
 inline void add_stats(path_stats& a, const path_stats& b) {
   a.camera_rays += b.camera_rays;
   a.shadow_rays += b.shadow_rays;
   a.bounce_rays += b.bounce_rays;
   a.nee_samples += b.nee_samples;
+  a.nee_zero += b.nee_zero;
   a.bad_samples += b.bad_samples;
 }
 
@@ -59,10 +60,12 @@ inline bool unoccluded(const render_inputs& in, const surface_point& sp, const l
   return !occluded(*in.bvh, o, d / t, t);
 }
 
-// Radiance of sample `sample` of pixel (x, y).
+// Radiance of sample `sample` of pixel (x, y). `ctxs` are the light-selection contexts of the current and the
+// previous vertex (alternating by depth); the caller keeps them across samples of a row, so that samplers can
+// reuse per-point work between neighbouring samples (e.g. a region lookup).
 template <class Sampler, class Sink>
 vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample, path_stats& st,
-                 Sink& sink) {
+                 Sink& sink, typename Sampler::context (&ctxs)[2]) {
   const scene_data& scene = *in.scene;
   const light_data& lights = *in.lights;
   int pixel = y * in.camera.width + x;
@@ -75,8 +78,6 @@ vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, 
   vec3f radiance = {0, 0, 0}, beta = {1, 1, 1};
   bool prev_mis = false;           // the current ray was BSDF-sampled at a vertex that also ran weighted NEE
   float prev_bsdf_pdf = 0;
-  // Light-selection contexts of the current and the previous vertex, alternating (no copies of large cdfs).
-  typename Sampler::context ctxs[2];
   for (int depth = 1;; depth++) {
     hit_info h = intersect(*in.bvh, org, dir);
     if (h.tri == invalid_id) {
@@ -131,6 +132,7 @@ vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, 
           }
         }
       }
+      st.nee_zero += value == 0;
       if constexpr (Sampler::learns) sink.record(nee_event<typename Sampler::context>{&ctx, choice, value});
     }
     if (last) break;

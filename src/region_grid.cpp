@@ -26,20 +26,18 @@ void key_cell(uint64_t key, int& i, int& j, int& k) {
 }
 
 void table_insert(region_state& s, uint64_t key, int id) {
-  size_t mask = s.table_key.size() - 1;
+  size_t mask = s.table.size() - 1;
   size_t h = size_t(mix64(key)) & mask;
-  while (s.table_key[h] != empty_region_key) h = (h + 1) & mask;
-  s.table_key[h] = key;
-  s.table_id[h] = id;
+  while (s.table[h].key != empty_region_key) h = (h + 1) & mask;
+  s.table[h] = {key, id};
 }
 
 // Grows the table to keep its load at most 1/2 for `regions` entries.
 void reserve_table(region_state& s, size_t regions) {
   size_t want = 16;
   while (want < 2 * regions) want *= 2;
-  if (want <= s.table_key.size()) return;
-  s.table_key.assign(want, empty_region_key);
-  s.table_id.assign(want, invalid_id);
+  if (want <= s.table.size()) return;
+  s.table.assign(want, region_slot{empty_region_key, invalid_id});
   for (size_t r = 0; r < s.key.size(); r++) table_insert(s, s.key[r], int(r));
 }
 
@@ -161,12 +159,58 @@ bbox3f region_box(const region_grid_data& g, uint64_t key) {
   return {lo, lo + vec3f{c, c, c}};
 }
 
+bool add_pending(region_state& s, uint64_t key, uint32_t count) {
+  if (2 * (s.pending_count + 1) > s.pending.size()) {
+    std::vector<region_slot> old = std::move(s.pending);
+    s.pending.assign(std::max<size_t>(64, 2 * old.size()), region_slot{empty_region_key, 0});
+    size_t mask = s.pending.size() - 1;
+    for (const region_slot& e : old)
+      if (e.key != empty_region_key) {
+        size_t h = size_t(mix64(e.key)) & mask;
+        while (s.pending[h].key != empty_region_key) h = (h + 1) & mask;
+        s.pending[h] = e;
+      }
+  }
+  size_t mask = s.pending.size() - 1;
+  size_t h = size_t(mix64(key)) & mask;
+  while (s.pending[h].key != empty_region_key && s.pending[h].key != key) h = (h + 1) & mask;
+  if (s.pending[h].key == empty_region_key) {
+    s.pending[h] = {key, 0};
+    s.pending_count++;
+  }
+  s.pending[h].id = int(std::min<int64_t>(int64_t(s.pending[h].id) + count, 1 << 30));
+  return s.pending[h].id >= s.params.min_samples;
+}
+
+void remove_pending(region_state& s, uint64_t key) {
+  // Linear probing deletion by backward shift (keeps every remaining key reachable).
+  if (s.pending.empty()) return;
+  size_t mask = s.pending.size() - 1;
+  size_t h = size_t(mix64(key)) & mask;
+  while (s.pending[h].key != key) {
+    if (s.pending[h].key == empty_region_key) return;
+    h = (h + 1) & mask;
+  }
+  size_t hole = h;
+  for (size_t j = (hole + 1) & mask; s.pending[j].key != empty_region_key; j = (j + 1) & mask) {
+    size_t home = size_t(mix64(s.pending[j].key)) & mask;
+    // Move j into the hole if its home is not cyclically in (hole, j].
+    bool in_between = hole <= j ? (home > hole && home <= j) : (home > hole || home <= j);
+    if (!in_between) {
+      s.pending[hole] = s.pending[j];
+      hole = j;
+    }
+  }
+  s.pending[hole] = {empty_region_key, 0};
+  s.pending_count--;
+}
+
 int find_region_key(const region_state& s, uint64_t key) {
-  size_t mask = s.table_key.size() - 1;
+  size_t mask = s.table.size() - 1;
   for (size_t h = size_t(mix64(key)) & mask;; h = (h + 1) & mask) {
-    uint64_t k = s.table_key[h];
-    if (k == key) return s.table_id[h];
-    if (k == empty_region_key) return invalid_id;
+    const region_slot& slot = s.table[h];
+    if (slot.key == key) return slot.id;
+    if (slot.key == empty_region_key) return invalid_id;
   }
 }
 
@@ -265,7 +309,7 @@ std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool
 
 size_t region_memory_bytes(const region_state& s) {
   return s.key.size() * (sizeof(uint64_t) + 4 * sizeof(int)) + (s.cut_nodes.size() + s.pair_parent.size()) * sizeof(int) +
-         s.table_key.size() * (sizeof(uint64_t) + sizeof(int));
+         (s.table.size() + s.pending.size()) * sizeof(region_slot);
 }
 
 }  // namespace bl

@@ -23,7 +23,8 @@ struct region_params {
   float coherence = 0.25f;         // keep a node whole when radius / gap to the region <= this and its
                                    // normals lie within 30 degrees (its lights light the region alike)
   int shared_cut_lights = 4;       // at most this many lights: one cut of all lights, no clustering
-  int64_t max_pairs = int64_t(1) << 23;  // memory budget in (region, cluster) pairs
+  int min_samples = 16;            // NEE samples a fine cell must ask for before its region is created
+  int64_t max_pairs = int64_t(1) << 20;  // memory budget in (region, cluster) pairs
 };
 
 // Cluster id of the sun inside a cut (tree nodes are >= 0).
@@ -35,6 +36,12 @@ struct region_grid_data {
   vec3f origin;
   float cell[region_levels];
   int dims[region_levels][3];
+};
+
+// One slot of the key -> region table (key and id together: one cache line per probe).
+struct region_slot {
+  uint64_t key;
+  int id;
 };
 
 // Regions as flat columns, plus the key -> region lookup table.
@@ -51,8 +58,9 @@ struct region_state {
   std::vector<int> cut_nodes;          // concatenated sorted cuts (tree node ids, then sun_cluster)
   std::vector<int> pair_parent;        // per pair: the parent region's pair of the same cluster, or invalid_id
   int64_t pairs = 0;                   // total (region, cluster) pairs
-  std::vector<uint64_t> table_key;     // open addressing; empty slots hold empty_key
-  std::vector<int> table_id;
+  std::vector<region_slot> table;      // open addressing; empty slots hold empty_region_key
+  std::vector<region_slot> pending;    // fine keys not yet created -> NEE samples requested so far (same scheme)
+  size_t pending_count = 0;
   int root = 0;
 };
 
@@ -72,6 +80,11 @@ bbox3f region_box(const region_grid_data& g, uint64_t key);
 int find_region_key(const region_state& s, uint64_t key);
 // The finest existing region containing the fine cell `fine_key` (the root at worst).
 int find_region(const region_state& s, uint64_t fine_key);
+
+// Adds `count` requests for the fine key; true when its total reached params.min_samples.
+bool add_pending(region_state& s, uint64_t key, uint32_t count);
+// Forgets the pending count of a key (its region is being created).
+void remove_pending(region_state& s, uint64_t key);
 
 // Creates regions for requested fine keys (sorted, deduplicated by the caller): each fine key's coarse parent
 // first, then the fine region while the pair budget allows. Returns the number of regions added.

@@ -65,10 +65,11 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
         path_stats& st = rows.stats[size_t(y)];
         st = {};
         auto render_row = [&](auto& sink) {
+          typename Sampler::context ctxs[2];
           for (int x = 0; x < w; x++) {
             double sum[3] = {0, 0, 0};
             for (int s = s0; s < s1; s++) {
-              vec3f l = trace_path(in, sampler, x, y, uint64_t(s), st, sink);
+              vec3f l = trace_path(in, sampler, x, y, uint64_t(s), st, sink, ctxs);
               sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
             }
             double* out = &pass_sum[3 * (size_t(y) * w + x)];

@@ -28,6 +28,10 @@ std::string render_summary(const render_result& r, const std::vector<std::string
                 r.seconds > 0 ? rays / r.seconds * 1e-6 : 0.0,
                 r.seconds > 0 ? double(st.nee_samples) / r.seconds * 1e-6 : 0.0);
   std::string s = buf;
+  if (st.nee_samples > 0) {
+    std::snprintf(buf, sizeof buf, "; %.1f%% of NEE samples contribute nothing", 100.0 * double(st.nee_zero) / double(st.nee_samples));
+    s += buf;
+  }
   if (r.regions > 0) {
     std::snprintf(buf, sizeof buf, "; %d regions, %.1f clusters per region, %.1f MB sampler state", r.regions,
                   double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));

@@ -3,6 +3,9 @@
 // the reference, prior-only weights proportional to the bound, order-independent merging (Chan vs one pass),
 // convergence of a learned PMF to sqrt((1 - p0)(k^2 + h)) / d^2 with a tolerance derived from the estimator's
 // standard deviation, and the ablations (mean only, no prior, no distance regression).
+#include <catch2/catch.hpp>
+#include <memory>
+
 #include "bayes_sampler.h"
 #include "bayes_stats.h"
 #include "bound_sampler.h"
@@ -13,17 +16,17 @@
 #include "scene.h"
 #include "test_util.h"
 
-#include <catch2/catch.hpp>
-
-#include <memory>
-
 using namespace bl;
 using namespace bl::test;
 
 namespace {
 
-double unif(pcg32& r) { return (double(r() >> 5) * 67108864.0 + double(r() >> 6)) * (1.0 / 9007199254740992.0); }
-double log_uniform(pcg32& r, double lo, double hi) { return lo * std::pow(hi / lo, unif(r)); }
+double unif(pcg32& r) {
+  return (double(r() >> 5) * 67108864.0 + double(r() >> 6)) * (1.0 / 9007199254740992.0);
+}
+double log_uniform(pcg32& r, double lo, double hi) {
+  return lo * std::pow(hi / lo, unif(r));
+}
 // Standard normal (Box-Muller).
 double normal(pcg32& r) {
   double u1 = 1 - unif(r), u2 = unif(r);
@@ -90,8 +93,10 @@ moments exact_moments(const std::vector<double>& z) {
   moments m;
   long double s = 0;
   for (double v : z) {
-    if (v == 0) m.n0 += 1;
-    else m.n1 += 1, s += v;
+    if (v == 0)
+      m.n0 += 1;
+    else
+      m.n1 += 1, s += v;
   }
   long double mean = m.n1 > 0 ? s / m.n1 : 0, ss = 0;
   for (double v : z)
@@ -101,7 +106,9 @@ moments exact_moments(const std::vector<double>& z) {
   return m;
 }
 
-double rel_err(double a, double b) { return std::fabs(a - b) / std::max(std::fabs(b), 1e-300); }
+double rel_err(double a, double b) {
+  return std::fabs(a - b) / std::max(std::fabs(b), 1e-300);
+}
 
 // Parameter sets: the defaults, and a different prior.
 std::vector<bayes_params> param_sets() {
@@ -119,8 +126,10 @@ std::vector<bayes_params> param_sets() {
 std::vector<double> synthetic(pcg32& r, int n, double p0, double k, double h, double d) {
   std::vector<double> y;
   for (int i = 0; i < n; i++) {
-    if (unif(r) < p0) y.push_back(0);
-    else y.push_back(std::fabs(k + std::sqrt(h) * normal(r)) / (d * d));
+    if (unif(r) < p0)
+      y.push_back(0);
+    else
+      y.push_back(std::fabs(k + std::sqrt(h) * normal(r)) / (d * d));
   }
   return y;
 }
@@ -208,13 +217,17 @@ TEST_CASE("the reference posterior weight is the conjugate Normal inverse gamma 
         np.prior = false;
         double naive = posterior_weight(np, bound, scale, dc.d, m.n0, m.n1, m.mean, m.m2);
         long double naive_ref = hand_naive(bound, scale, dc.d, y, true);
-        if (naive_ref == 0) CHECK(naive == 0);
-        else CHECK(rel_err(naive, double(naive_ref)) < 1e-9);
+        if (naive_ref == 0)
+          CHECK(naive == 0);
+        else
+          CHECK(rel_err(naive, double(naive_ref)) < 1e-9);
         np.second_moment = false;
         double naive_mean = posterior_weight(np, bound, scale, dc.d, m.n0, m.n1, m.mean, m.m2);
         long double naive_mean_ref = hand_naive(bound, scale, dc.d, y, false);
-        if (naive_mean_ref == 0) CHECK(naive_mean == 0);
-        else CHECK(rel_err(naive_mean, double(naive_mean_ref)) < 1e-9);
+        if (naive_mean_ref == 0)
+          CHECK(naive_mean == 0);
+        else
+          CHECK(rel_err(naive_mean, double(naive_mean_ref)) < 1e-9);
         // With the prior, every cluster with a non-zero bound keeps a finite positive weight.
         CHECK(std::isfinite(w));
         CHECK(w > 0);
@@ -250,22 +263,23 @@ TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes
         rows[size_t(rng(3))].add(i, z);
       }
     }
-    merge_rows(s, rows, p);
+    merge_rows(s, rows, p, nullptr);
+    refresh_weights(s, nullptr, p);
     int worst_pair = -1;
     double worst = 0;
     for (int i = 0; i < pairs; i++)
       for (int k = 0; k < 20; k++) {
         double bound = log_uniform(rng, 1e-8, 1e8), scale = log_uniform(rng, 0.01, 1), d = log_uniform(rng, 1e-3, 1e3);
         double v = scale * bound, g = 1 / (d * d);
-        double fast = eval_weight(s, size_t(i), p, s.p1[size_t(i)], v, g);
-        double ref = posterior_weight(p, bound, scale, d, s.n0[size_t(i)], s.n1[size_t(i)], s.mean[size_t(i)],
-                                      s.m2[size_t(i)]);
+        double fast = eval_weight(s.weight[size_t(i)], p, v, g);
+        double ref =
+            posterior_weight(p, bound, scale, d, s.n0[size_t(i)], s.n1[size_t(i)], s.mean[size_t(i)], s.m2[size_t(i)]);
         double e = ref == 0 ? std::fabs(fast) : rel_err(fast, ref);
         if (e > worst) worst = e, worst_pair = i;
       }
     INFO("prior " << p.prior << " second moment " << p.second_moment << " alpha0 " << p.alpha0 << ": worst pair "
-                  << worst_pair << " n0 " << s.n0[size_t(worst_pair)] << " n1 " << s.n1[size_t(worst_pair)]
-                  << " mean " << s.mean[size_t(worst_pair)] << " m2 " << s.m2[size_t(worst_pair)]);
+                  << worst_pair << " n0 " << s.n0[size_t(worst_pair)] << " n1 " << s.n1[size_t(worst_pair)] << " mean "
+                  << s.mean[size_t(worst_pair)] << " m2 " << s.m2[size_t(worst_pair)]);
     CHECK(worst < 1e-5);
   }
 }
@@ -275,15 +289,15 @@ TEST_CASE("prior only weights are proportional to the bound", "[bayes]") {
     bayes_stats s;
     resize_stats(s, 5, p);
     pcg32 rng(41, 3);
-    double ratio = eval_weight(s, 0, p, s.p1[0], 1.0, 1.0);
+    double ratio = eval_weight(s.weight[0], p, 1.0, 1.0);
     CHECK(ratio > 0);
     for (int k = 0; k < 200; k++) {
       double v = log_uniform(rng, 1e-10, 1e10), g = log_uniform(rng, 1e-6, 1e6);
-      CHECK(rel_err(eval_weight(s, size_t(k % 5), p, s.p1[size_t(k % 5)], v, g), ratio * v) < 1e-12);
+      CHECK(rel_err(eval_weight(s.weight[size_t(k % 5)], p, v, g), ratio * v) < 1e-12);
       double d = 1 / std::sqrt(g);
       CHECK(rel_err(posterior_weight(p, v, 1.0, d, 0, 0, 0, 0), ratio * v) < 1e-6);  // float coefficient
     }
-    CHECK(eval_weight(s, 0, p, s.p1[0], 0.0, 1.0) == 0);
+    CHECK(eval_weight(s.weight[0], p, 0.0, 1.0) == 0);
   }
 }
 
@@ -367,11 +381,13 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
     if (grouping == 0) {
       std::vector<bayes_row> rows(1);
       for (auto [i, z] : stream) rows[0].add(i, z);
-      merge_rows(s, rows, p);
+      merge_rows(s, rows, p, nullptr);
+      refresh_weights(s, nullptr, p);
     } else if (grouping == 1) {
       std::vector<bayes_row> rows(stream.size());
       for (size_t k = 0; k < stream.size(); k++) rows[k].add(stream[k].first, stream[k].second);
-      merge_rows(s, rows, p);
+      merge_rows(s, rows, p, nullptr);
+      refresh_weights(s, nullptr, p);
     } else {
       size_t k = 0;
       for (int pass = 0; pass < 4; pass++) {
@@ -384,7 +400,8 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
           copy.clear();
           CHECK(copy.acc.empty());
         }
-        merge_rows(s, rows, p);
+        merge_rows(s, rows, p, nullptr);
+        refresh_weights(s, nullptr, p);
       }
     }
     for (int i = 0; i < pairs; i++) {
@@ -397,9 +414,9 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
       CHECK(rel_err(s.mean[size_t(i)], ex.mean) <= 1e-12);
       CHECK(rel_err(s.m2[size_t(i)], ex.m2) <= 1e-12);
       // The coefficients were refreshed from the merged statistics.
-      double ref = posterior_weight(p, 2.0, 0.3, 1.5, s.n0[size_t(i)], s.n1[size_t(i)], s.mean[size_t(i)],
-                                    s.m2[size_t(i)]);
-      CHECK(rel_err(eval_weight(s, size_t(i), p, s.p1[size_t(i)], 0.6, 1 / 2.25), ref) < 1e-5);
+      double ref =
+          posterior_weight(p, 2.0, 0.3, 1.5, s.n0[size_t(i)], s.n1[size_t(i)], s.mean[size_t(i)], s.m2[size_t(i)]);
+      CHECK(rel_err(eval_weight(s.weight[size_t(i)], p, 0.6, 1 / 2.25), ref) < 1e-5);
     }
   }
 }
@@ -410,15 +427,17 @@ TEST_CASE("decaying statistics scales the counts and keeps the mean", "[bayes]")
   resize_stats(s, 2, p);
   std::vector<bayes_row> rows(1);
   for (double z : {0.0, 1.0, 2.0, 0.0, 4.0}) rows[0].add(1, z);
-  merge_rows(s, rows, p);
+  merge_rows(s, rows, p, nullptr);
+  refresh_weights(s, nullptr, p);
   double mean = s.mean[1], m2 = s.m2[1];
   decay_stats(s, 0.5, p);
+  refresh_weights(s, nullptr, p);
   CHECK(s.n0[1] == 1.0);
   CHECK(s.n1[1] == 1.5);
   CHECK(s.mean[1] == mean);
   CHECK(s.m2[1] == 0.5 * m2);
-  CHECK(rel_err(eval_weight(s, 1, p, s.p1[1], 0.2, 0.5), posterior_weight(p, 0.2, 1.0, std::sqrt(2.0), 1.0, 1.5, mean, 0.5 * m2)) <
-        1e-5);
+  CHECK(rel_err(eval_weight(s.weight[1], p, 0.2, 0.5),
+                posterior_weight(p, 0.2, 1.0, std::sqrt(2.0), 1.0, 1.5, mean, 0.5 * m2)) < 1e-5);
 }
 
 namespace {
@@ -434,8 +453,8 @@ struct convergence_setup {
 
 struct convergence_result {
   double learned[3], target[3], prior[3];
-  double tolerance;          // on |learned / target - 1|, see below
-  double mean_error = 0;     // worst relative error of the stored means against the recorded z
+  double tolerance;       // on |learned / target - 1|, see below
+  double mean_error = 0;  // worst relative error of the stored means against the recorded z
 };
 
 convergence_result run_convergence(const bayes_params& params, const convergence_setup& cs, int n, uint64_t seed) {
@@ -489,7 +508,8 @@ convergence_result run_convergence(const bayes_params& params, const convergence
     s.learn(rows);
   }
   for (int j = 0; j < 3; j++)
-    r.mean_error = std::max(r.mean_error, rel_err(s.stats.mean[base + size_t(j)], double(zsum[size_t(j)] / zcount[size_t(j)])));
+    r.mean_error =
+        std::max(r.mean_error, rel_err(s.stats.mean[base + size_t(j)], double(zsum[size_t(j)] / zcount[size_t(j)])));
   s.prepare(*ctx, pt);
   double total = 0, sigma = 0, bias = 0;
   for (int j = 0; j < 3; j++) {
@@ -509,7 +529,8 @@ convergence_result run_convergence(const bayes_params& params, const convergence
     // beta0 and the (z - mu0)^2 term on the variance.
     double pull = (params.a0 + params.b0 + 2 * params.kappa0 * std::max(1.0, 1 / f) +
                    2 * (params.c * (params.alpha0 - 1) / (f * f) + params.kappa0 * (1 + 1 / f) * (1 + 1 / f) +
-                        (params.alpha0 - 1))) / n1;
+                        (params.alpha0 - 1))) /
+                  n1;
     bias = std::max(bias, params.prior ? pull : 0.0);
     total += r.target[j];
   }
@@ -659,7 +680,8 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     // More observations of cluster 0 reach only the parent: its posterior now differs from the fine pair's.
     std::vector<bayes_row> more(1);
     for (int k = 0; k < 6; k++) more[0].add(s.regions.pair_offset[size_t(coarse)], 3.0 + k);
-    merge_rows(s.stats, more, s.params);
+    merge_rows(s.stats, more, s.params, nullptr);
+    refresh_weights(s.stats, &s.regions.pair_parent, s.params);
     s.prepare(*ctx, pt);
     double w[3], own[3], sw = 0, sown = 0;
     double scale = pt.albedo * inv_pi_f;
@@ -669,10 +691,10 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
       float num = cluster_bound_parts(t->tree, t->lights, ctx->nodes[j], pt.p, pt.n, 0, 1, inv_d2);
       double bound = double(num) * inv_d2;
       double d = 1 / std::sqrt(double(inv_d2));
-      double wf = posterior_weight(s.params, bound, scale, d, s.stats.n0[i], s.stats.n1[i], s.stats.mean[i],
-                                   s.stats.m2[i]);
-      double wp = posterior_weight(s.params, bound, scale, d, s.stats.n0[up], s.stats.n1[up], s.stats.mean[up],
-                                   s.stats.m2[up]);
+      double wf =
+          posterior_weight(s.params, bound, scale, d, s.stats.n0[i], s.stats.n1[i], s.stats.mean[i], s.stats.m2[i]);
+      double wp =
+          posterior_weight(s.params, bound, scale, d, s.stats.n0[up], s.stats.n1[up], s.stats.mean[up], s.stats.m2[up]);
       const bayes_params& bp = s.params;
       double n = s.stats.n0[i] + s.stats.n1[i], np = s.stats.n0[up] + s.stats.n1[up];
       double p1_own = (bp.b0 + s.stats.n1[i]) / (bp.a0 + bp.b0 + n);
@@ -694,4 +716,3 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     CHECK(gap > 1e-2);  // decisive: the parent's extra data visibly moves the blend away from the fine posterior
   }
 }
-

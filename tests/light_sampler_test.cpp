@@ -185,7 +185,8 @@ path_stats learn_passes(const render_inputs& in, S& s, int passes) {
     for (int y = 0; y < h; y++) {
       rows[size_t(y)].clear();
       row_sink<S> sink{&s, &rows[size_t(y)]};
-      for (int x = 0; x < w; x++) trace_path(in, s, x, y, uint64_t(pass), st, sink);
+      typename S::context ctxs[2];
+      for (int x = 0; x < w; x++) trace_path(in, s, x, y, uint64_t(pass), st, sink, ctxs);
     }
     s.learn(rows);
   }
@@ -386,8 +387,9 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
           for (size_t i = 0; i < b->stats.n0.size(); i++) {
             n += b->stats.n0[i] + b->stats.n1[i];
             finite = finite && std::isfinite(b->stats.mean[i]) && std::isfinite(b->stats.m2[i]) &&
-                     std::isfinite(b->stats.q2[i]) && std::isfinite(b->stats.q1[i]) &&
-                     std::isfinite(b->stats.q0[i]) && std::isfinite(b->stats.qc[i]);
+                     std::isfinite(b->stats.weight[i].w2) && std::isfinite(b->stats.weight[i].w1) &&
+                     std::isfinite(b->stats.weight[i].w0) && std::isfinite(b->stats.weight[i].wc) &&
+                     std::isfinite(b->stats.coeffs[i].p1);
           }
           CHECK(n > 0);
           CHECK(finite);

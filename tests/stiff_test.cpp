@@ -92,8 +92,9 @@ void check_bayes_state(const built_scene& b, int depth) {
     for (int y = 0; y < image_size; y++) {
       rows[size_t(y)].clear();
       row_sink<bayes_sampler> sink{&s, &rows[size_t(y)]};
+      cut_context ctx_pair[2];
       for (int x = 0; x < image_size; x++) {
-        vec3f l = trace_path(in, s, x, y, uint64_t(pass), st, sink);
+        vec3f l = trace_path(in, s, x, y, uint64_t(pass), st, sink, ctx_pair);
         REQUIRE(is_finite(l));
       }
     }
@@ -106,8 +107,9 @@ void check_bayes_state(const built_scene& b, int depth) {
     observations += s.stats.n0[i] + s.stats.n1[i];
     bool ok = std::isfinite(s.stats.n0[i]) && std::isfinite(s.stats.n1[i]) && std::isfinite(s.stats.mean[i]) &&
               std::isfinite(s.stats.m2[i]) && s.stats.m2[i] >= 0 && s.stats.mean[i] >= 0 &&
-              std::isfinite(s.stats.q2[i]) && std::isfinite(s.stats.q1[i]) && std::isfinite(s.stats.q0[i]) &&
-              std::isfinite(s.stats.qc[i]);
+              std::isfinite(s.stats.weight[i].w2) && std::isfinite(s.stats.weight[i].w1) &&
+                     std::isfinite(s.stats.weight[i].w0) && std::isfinite(s.stats.weight[i].wc) &&
+                     std::isfinite(s.stats.coeffs[i].p1);
     if (!ok) bad++;
   }
   INFO("pairs " << s.stats.n0.size() << " observations " << observations);
