@@ -22,6 +22,7 @@ constexpr int max_cut_entries = 1025;
 struct cut_context {
   vec3f p, n;
   float albedo = 0;
+  int pixel = invalid_id;      // (samplers that learn per pixel)
   uint64_t fine_key = ~uint64_t(0);  // (no fine key yet: see locate_region's reuse of the last lookup)
   int region = 0;
   int count = 0;               // clusters in the cut

@@ -69,7 +69,7 @@ std::string sampler_names() {
   return s;
 }
 
-bool sampler_available(sampler_kind kind) { return kind != sampler_kind::donikian; }
+bool sampler_available(sampler_kind) { return true; }
 
 bool needs_light_tree(sampler_kind kind) {
   return kind == sampler_kind::bvh || kind == sampler_kind::bound || kind == sampler_kind::bayes ||
@@ -93,6 +93,18 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.regions = make_regions(params, in, tree);
       return s;
     }
+    case sampler_kind::donikian: {
+      bound_sampler b;
+      b.tree = &tree;
+      b.lights = &lights;
+      b.sun_sin = sun_sin;
+      b.sun_cos = sun_cos;
+      b.regions = make_regions(params, in, tree);
+      region_params rp = params.regions;
+      rp.max_cut = std::min(std::max(rp.max_cut, 1), max_cut_entries - 1);
+      return make_donikian_sampler(tree, lights, std::move(b), in.camera.width, in.camera.height, params.donikian, rp,
+                                   in.scene->bounds);
+    }
     case sampler_kind::bayes: {
       bayes_sampler s;
       s.tree = &tree;
@@ -113,6 +125,9 @@ size_t sampler_memory_bytes(const light_sampler& s) {
   if (auto* b = std::get_if<bound_sampler>(&s)) return region_memory_bytes(b->regions);
   if (auto* b = std::get_if<bayes_sampler>(&s))
     return region_memory_bytes(b->regions) + b->stats.n0.size() * (4 * sizeof(double) + sizeof(pair_coeffs) + sizeof(pair_weight));
+  if (auto* d = std::get_if<donikian_sampler>(&s))
+    return region_memory_bytes(d->deeper.regions) +
+           (d->pixel_sum.size() + d->pixel_count.size() + d->block_sum.size() + d->block_count.size()) * sizeof(float);
   return 0;
 }
 

@@ -5,6 +5,7 @@
 #include "bayes_sampler.h"
 #include "bound_sampler.h"
 #include "bvh_sampler.h"
+#include "donikian_sampler.h"
 #include "light_sampler_types.h"
 #include "light_tree.h"
 #include "lights.h"
@@ -19,13 +20,15 @@ namespace bl {
 struct render_inputs;
 
 // The closed set.
-using light_sampler = std::variant<uniform_sampler, power_sampler, bvh_sampler, bound_sampler, bayes_sampler>;
+using light_sampler =
+    std::variant<uniform_sampler, power_sampler, bvh_sampler, bound_sampler, donikian_sampler, bayes_sampler>;
 
 // Options of light selection (ablation switches of the adaptive samplers included).
 struct sampler_params {
   sampler_kind kind = sampler_kind::bayes;
   region_params regions;
   bayes_params bayes;
+  donikian_params donikian;
 };
 
 // Whether a sampler kind uses the light tree.

@@ -56,7 +56,8 @@ camera_params looking_down(float h) {
   return c;
 }
 
-const sampler_kind kinds[] = {sampler_kind::uniform, sampler_kind::power};
+const sampler_kind kinds[] = {sampler_kind::uniform, sampler_kind::power,    sampler_kind::bvh,
+                              sampler_kind::bound,   sampler_kind::donikian, sampler_kind::bayes};
 
 }  // namespace
 
@@ -88,15 +89,17 @@ TEST_CASE("a furnace box of emitting grey walls sums its bounces", "[analytic]")
       mesh_builder b;
       int wall = b.add_material({rho, rho, rho}, {le, le, le});
       b.add_box({-1, -1, -1}, {1, 1, 1}, wall);
+      // A narrow view of a wall's centre: first hits stay 0.8 away from the edges, where area sampling of the
+      // adjacent emitting wall has an unbounded integrand (heavy tails that no sample count makes decisive).
       camera_params cam;
       cam.automatic = false;
       cam.eye = {0, 0, 0};
-      cam.target = {0.3f, 0.2f, 1};
-      cam.fov_y_deg = 60;
+      cam.target = {0, 0, 1};
+      cam.fov_y_deg = 12;
       double exact = 0;
       for (int k = 0; k <= depth; k++) exact += le * std::pow(rho, k);
       INFO("sampler " << sampler_name(kind) << " depth " << depth);
-      check_estimate(render_pixels(b.mesh, cam, {}, true, kind, depth, 128), exact);
+      check_estimate(render_pixels(b.mesh, cam, {}, true, kind, depth, 256), exact);
     }
 }
 

@@ -12,7 +12,7 @@ using namespace bl::test;
 
 namespace {
 
-const char* samplers[] = {"uniform", "power", "bvh", "bound", "bayes"};
+const char* samplers[] = {"uniform", "power", "bvh", "bound", "donikian", "bayes"};
 
 // A small render of a data/ scene with occlusion, a sun and textures (the living room, path traced).
 std::string render_args(const std::string& sampler, const std::string& extra) {
@@ -43,7 +43,7 @@ TEST_CASE("one and two threads give byte identical files for every sampler", "[d
 
 TEST_CASE("a time budget run equals the spp run of the same sample count", "[determinism]") {
   temp_dir d;
-  for (const char* s : {"power", "bound", "bayes"}) {
+  for (const char* s : {"power", "bound", "donikian", "bayes"}) {
     std::string t = d / "t.pfm", n = d / "n.pfm", log = d / "t.csv";
     auto rt = run_bayeslight(render_args(s, "--time 0.3 --threads 2 -o " + t + " --log " + log));
     INFO(s << "\n" << rt.output);

@@ -35,5 +35,5 @@ TEST_CASE("every golden render reproduces its image bit for bit", "[golden]") {
     }
     checked++;
   }
-  CHECK(checked >= 40);
+  CHECK(checked >= 48);
 }

@@ -8,7 +8,7 @@ bin=$1
 cd "$(dirname "$0")/.."
 T=${T:-10}; W=${W:-320}; H=${H:-240}
 SCENES=${SCENES:-"cornell living_room plant_room hall"}; MODES=${MODES:-"direct path"}
-SAMPLERS=${SAMPLERS:-"uniform power bvh bound bayes"}
+SAMPLERS=${SAMPLERS:-"uniform power bvh bound donikian bayes"}
 REF_SPP_DIRECT=${REF_SPP_DIRECT:-4096}; REF_SPP_PATH=${REF_SPP_PATH:-2048}
 refdir=$(dirname "$bin")/ref; mkdir -p "$refdir"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT

@@ -5,7 +5,7 @@
 set -euo pipefail
 bin=${1:-build/bayeslight}
 cd "$(dirname "$0")/.."
-samplers="uniform power bvh bound bayes"
+samplers="uniform power bvh bound donikian bayes"
 out=golden
 mkdir -p "$out"
 rm -f "$out"/*.pfm
