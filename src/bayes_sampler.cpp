@@ -52,6 +52,12 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   row.add(regions.pair_offset[size_t(ctx.region)] + j, z);
 }
 
+void bayes_sampler::begin_frame(double decay) {
+  if (decay >= 1) return;
+  decay_stats(stats, decay, params);
+  refresh_weights(stats, &regions.pair_parent, params);
+}
+
 void bayes_sampler::learn(std::vector<row_state>& rows) {
   merge_rows(stats, rows, params, params.hierarchy > 0 ? &regions.pair_parent : nullptr);
   std::vector<const region_requests*> r;

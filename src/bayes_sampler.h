@@ -31,6 +31,8 @@ struct bayes_sampler {
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
   void record(row_state& row, const nee_event<context>& e) const;
   void learn(std::vector<row_state>& rows);
+  // Scales every statistic by `decay` (the prior regains weight) and refreshes the weights.
+  void begin_frame(double decay);
 };
 
 }  // namespace bl

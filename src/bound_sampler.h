@@ -27,6 +27,7 @@ struct bound_sampler {
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
   void record(row_state& row, const nee_event<context>& e) const { row.add(regions, *e.context); }
   void learn(std::vector<row_state>& rows);
+  void begin_frame(double) {}  // regions and cuts do not depend on the sun's direction
 };
 
 }  // namespace bl

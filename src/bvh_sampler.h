@@ -27,6 +27,7 @@ struct bvh_sampler {
   light_choice sample(const context& ctx, double u, double) const;
   float pmf(const context& ctx, int light) const;
   void end_pass() {}
+  void begin_frame(double) {}
 };
 
 // Importance of the sun for a receiver normal n: luminance(E) * cos bound over the disk.

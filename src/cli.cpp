@@ -3,6 +3,7 @@
 #include "cli.h"
 
 #include "bvh.h"
+#include "compare.h"
 #include "errors.h"
 #include "file_io.h"
 #include "image_io.h"
@@ -18,6 +19,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <climits>
 #include <csignal>
 #include <cstdio>
@@ -48,11 +51,22 @@ struct render_options {
   region_params regions;
   bayes_params bayes;
   std::string bayes_pmf = "second-moment";
+  int frames = 1;
+  double frame_decay = 0.5;
 };
 
 // Options of `diff`.
 struct diff_options {
   std::string a, b;
+};
+
+// Options of `compare` (render.sampler, render.outputs and render.log are unused).
+struct compare_options {
+  render_options render;
+  std::vector<std::string> samplers;
+  std::string out;
+  int runs = 1;
+  std::string reference_note;
 };
 
 // Largest image a command line may ask for (same limits as scene files).
@@ -86,55 +100,94 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.sampler.regions = o.regions;
   p.sampler.bayes = o.bayes;
   p.sampler.bayes.second_moment = o.bayes_pmf == "second-moment";
+  p.frames = o.frames;
+  p.frame_decay = o.frame_decay;
   p.progress = !o.quiet && stderr_is_terminal();
   return p;
+}
+
+// Whether a path holds exactly one printf integer directive (%d, %04d, ...) and no other '%'.
+bool is_frame_pattern(const std::string& p) {
+  size_t at = p.find('%');
+  if (at == std::string::npos) return false;
+  size_t k = at + 1;
+  while (k < p.size() && (std::isdigit(static_cast<unsigned char>(p[k])) != 0)) k++;
+  return k < p.size() && p[k] == 'd' && p.find('%', k) == std::string::npos;
+}
+// The path of frame `frame` of a frame pattern (the path itself when it is not a pattern).
+std::string frame_path(const std::string& pattern, int frame) {
+  if (!is_frame_pattern(pattern)) return pattern;
+  char buf[4096];
+  std::snprintf(buf, sizeof buf, pattern.c_str(), frame);
+  return buf;
+}
+
+// Reads a reference image and checks its size.
+image_data load_reference(const std::string& path, const render_params& params) {
+  image_data ref = read_image(path);
+  if (ref.width != params.width || ref.height != params.height)
+    throw input_error(path, "reference is " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
+                                " but the render is " + std::to_string(params.width) + "x" +
+                                std::to_string(params.height));
+  return ref;
 }
 
 int run_render(const render_options& o) {
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
-  if (!sampler_available(kind))
-    throw usage_error("sampler \"" + o.sampler + "\" is not implemented yet in this build");
   std::vector<std::string> outputs = o.outputs;
-  if (outputs.empty()) outputs.push_back(fs::path(o.scene).stem().string() + ".exr");
+  if (outputs.empty())
+    outputs.push_back(fs::path(o.scene).stem().string() + (o.frames > 1 ? "_%04d.exr" : ".exr"));
   for (const std::string& out : outputs)
     if (image_format_of(out) == image_format::unknown)
       throw usage_error("output " + out + ": unknown image format (use .exr, .pfm or .png)");
-  for (const std::string& out : outputs) check_output_path(out);
-  if (!o.log.empty()) check_output_path(o.log);
+  if (o.frames > 1) {
+    // Every per-frame file names its frame with a printf pattern such as out_%04d.exr.
+    for (const std::string& out : outputs)
+      if (!is_frame_pattern(out)) throw usage_error("--frames needs a frame pattern in -o (e.g. out_%04d.exr): " + out);
+    if (!o.log.empty() && !is_frame_pattern(o.log)) throw usage_error("--frames needs a frame pattern in --log: " + o.log);
+    if (!o.reference.empty() && !is_frame_pattern(o.reference))
+      throw usage_error("--frames needs a frame pattern in --reference: " + o.reference);
+  }
+  for (const std::string& out : outputs) check_output_path(frame_path(out, 0));
+  if (!o.log.empty()) check_output_path(frame_path(o.log, 0));
 
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
-  image_data reference;
-  if (!o.reference.empty()) {
-    reference = read_image(o.reference);
-    if (reference.width != params.width || reference.height != params.height)
-      throw input_error(o.reference, "reference is " + std::to_string(reference.width) + "x" +
-                                         std::to_string(reference.height) + " but the render is " +
-                                         std::to_string(params.width) + "x" + std::to_string(params.height));
-    params.reference = &reference;
-  }
+  std::vector<image_data> references;
+  if (!o.reference.empty())
+    for (int f = 0; f < params.frames; f++) references.push_back(load_reference(frame_path(o.reference, f), params));
+  for (const image_data& r : references) params.frame_references.push_back(&r);
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
   if (scene.mesh.dropped_degenerate > 0)
     std::fprintf(stderr, "%s: dropped %d degenerate (zero-area) triangles\n", desc.mesh_path.c_str(),
                  scene.mesh.dropped_degenerate);
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
-  if (lights.count == 0) std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n",
-                                      o.scene.c_str());
+  if (lights.count == 0)
+    std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", o.scene.c_str());
 
   install_interrupt_handlers();
-  render_result result = render(scene, bvh, lights, params);
-  int sig = interrupt_signal();
-
-  if (result.spp > 0) {
-    image_data img = film_image(result);
-    for (const std::string& out : outputs) write_image(out, img);
+  bool interrupted = false;
+  render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
+    std::vector<std::string> files;
+    for (const std::string& out : outputs) files.push_back(frame_path(out, frame));
+    if (result.spp > 0) {
+      image_data img = film_image(result);
+      for (const std::string& f : files) write_image(f, img);
+    }
+    if (!o.log.empty()) write_file_atomic(frame_path(o.log, frame), pass_log_csv(o.sampler, result.log));
+    if (!o.quiet || result.interrupted) {
+      std::string prefix = params.frames > 1 ? "frame " + std::to_string(frame) + ": " : "";
+      std::fprintf(stderr, "%s%s\n", prefix.c_str(), render_summary(result, files).c_str());
+    }
+    interrupted = result.interrupted;
+  });
+  if (interrupted) {
+    int sig = interrupt_signal();
+    return 128 + (sig != 0 ? sig : SIGINT);
   }
-  if (!o.log.empty()) write_file_atomic(o.log, pass_log_csv(o.sampler, result.log));
-  if (!o.quiet || result.interrupted) std::fprintf(stderr, "%s\n", render_summary(result, outputs).c_str());
-  if (result.interrupted) return 128 + (sig != 0 ? sig : SIGINT);
   return exit_ok;
 }
 
@@ -149,10 +202,8 @@ int run_diff(const diff_options& o) {
   return exit_ok;
 }
 
-void add_render_command(CLI::App& app, render_options& o) {
-  CLI::App* r = app.add_subcommand("render", "Render a scene (.json scene file or bare .obj)");
-  r->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required();
-  r->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)");
+// The options `render` and `compare` share: spp or time, size, depth, threads, seed, quiet, sampler options.
+void add_render_options(CLI::App* r, render_options& o) {
   auto* spp = r->add_option("--spp", o.spp, "Samples per pixel (default: the scene's render.spp)")
                   ->check(CLI::Range(1, INT_MAX));
   auto* time = r->add_option("--time", o.time, "Render whole passes until this many seconds are spent")
@@ -166,10 +217,14 @@ void add_render_command(CLI::App& app, render_options& o) {
                                    "Random seed (default: the scene's render.seed)");
   r->add_option("--width", o.width, "Image width in pixels")->check(CLI::Range(1ll, max_side));
   r->add_option("--height", o.height, "Image height in pixels")->check(CLI::Range(1ll, max_side));
-  r->add_option("-o,--output", o.outputs, ".exr/.pfm (linear float RGB) or .png (8-bit sRGB); repeatable");
-  r->add_option("--reference", o.reference, "Reference .exr/.pfm of the same size: error after every pass");
-  r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse");
   r->add_flag("--quiet", o.quiet, "No progress bar or summary");
+  r->add_option("--frames", o.frames,
+                "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
+                "and --reference then take a frame pattern such as out_%04d.exr")
+      ->check(CLI::Range(1, 100000));
+  r->add_option("--frame-decay", o.frame_decay,
+                "Animations: learned statistics are scaled by this at each new frame (default 0.5; 1 keeps all)")
+      ->check(CLI::Range(0.0, 1.0));
   // Regions, cuts and the ablation switches of the adaptive samplers.
   const char* grp = "Regions and light cuts (bound, bayes)";
   r->add_option("--grid", o.regions.grid, "Region cells along the shortest axis of the scene bounds (default 64)")
@@ -209,6 +264,55 @@ void add_render_command(CLI::App& app, render_options& o) {
       ->check(CLI::PositiveNumber)->group(bg);
 }
 
+void add_render_command(CLI::App& app, render_options& o) {
+  CLI::App* r = app.add_subcommand("render", "Render a scene (.json scene file or bare .obj)");
+  r->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required();
+  r->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)");
+  r->add_option("-o,--output", o.outputs, ".exr/.pfm (linear float RGB) or .png (8-bit sRGB); repeatable");
+  r->add_option("--reference", o.reference, "Reference .exr/.pfm of the same size: error after every pass");
+  r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse");
+  add_render_options(r, o);
+}
+
+// ---- compare: equal-time (or equal-spp) comparison of samplers (compare.h does the work) ----
+
+void add_compare_command(CLI::App& app, compare_options& o) {
+  CLI::App* c = app.add_subcommand("compare", "Render several samplers for the same time (or spp) against a "
+                                              "reference: curves.csv, error_vs_time.svg, summary.md, images");
+  c->add_option("SCENE", o.render.scene, "Scene file (.json) or mesh (.obj)")->required();
+  c->add_option("--reference", o.render.reference, "Reference .exr/.pfm of the render's size")->required();
+  c->add_option("--samplers", o.samplers, "Comma-separated samplers, the first is the baseline: " + sampler_names())
+      ->required()->delimiter(',');
+  c->add_option("--out", o.out, "Output directory (created if missing)")->required();
+  c->add_option("--runs", o.runs, "Runs per sampler, seeds base, base+1, ... (default 1)")->check(CLI::Range(1, 10000));
+  c->add_option("--reference-note", o.reference_note, "How the reference was made, for summary.md");
+  add_render_options(c, o.render);
+}
+
+int run_compare_command(const compare_options& o) {
+  compare_params cp;
+  for (const std::string& name : o.samplers) {
+    sampler_kind kind;
+    if (!parse_sampler_kind(name, kind))
+      throw usage_error("unknown sampler \"" + name + "\" (valid: " + sampler_names() + ")");
+    if (!sampler_available(kind)) throw usage_error("sampler \"" + name + "\" is not implemented yet in this build");
+    if (std::find(cp.samplers.begin(), cp.samplers.end(), kind) != cp.samplers.end())
+      throw usage_error("sampler \"" + name + "\" is given twice in --samplers");
+    cp.samplers.push_back(kind);
+  }
+  if (cp.samplers.empty()) throw usage_error("--samplers names no sampler");
+  if ((o.render.spp > 0) == (o.render.time > 0)) throw usage_error("compare needs exactly one of --time and --spp");
+  scene_desc desc = load_scene_desc(o.render.scene);
+  cp.render = resolve_params(o.render, desc, cp.samplers[0]);
+  cp.runs = o.runs;
+  cp.scene_path = o.render.scene;
+  cp.reference_path = o.render.reference;
+  cp.reference_note = o.reference_note;
+  cp.out_dir = o.out;
+  cp.quiet = o.render.quiet;
+  return run_compare(desc, cp);
+}
+
 }  // namespace
 
 int run_cli(int argc, char** argv) {
@@ -216,13 +320,15 @@ int run_cli(int argc, char** argv) {
   app.require_subcommand(1);
   render_options ro;
   diff_options dopt;
+  compare_options copt;
   add_render_command(app, ro);
+  add_compare_command(app, copt);
   CLI::App* diff = app.add_subcommand("diff", "Compare two images: relmse, mse, maxabs; 'identical' if bit-equal");
   diff->add_option("A", dopt.a, "Image (.exr/.pfm)")->required();
   diff->add_option("B", dopt.b, "Image (.exr/.pfm), the reference")->required();
   std::string first = argc >= 2 ? argv[1] : "";
-  if (!first.empty() && first[0] != '-' && first != "render" && first != "diff") {
-    std::fprintf(stderr, "bayeslight: error: unknown command \"%s\" (commands: render, diff)\n"
+  if (!first.empty() && first[0] != '-' && first != "render" && first != "diff" && first != "compare") {
+    std::fprintf(stderr, "bayeslight: error: unknown command \"%s\" (commands: render, diff, compare)\n"
                          "Run with --help for more information.\n", first.c_str());
     return exit_usage;
   }
@@ -239,6 +345,7 @@ int run_cli(int argc, char** argv) {
   try {
     if (app.got_subcommand("render")) return run_render(ro);
     if (app.got_subcommand("diff")) return run_diff(dopt);
+    if (app.got_subcommand("compare")) return run_compare_command(copt);
   } catch (const usage_error& e) {
     std::fprintf(stderr, "bayeslight: error: %s\nRun with --help for more information.\n", e.what());
     return exit_usage;

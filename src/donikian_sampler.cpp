@@ -109,6 +109,15 @@ void donikian_sampler::learn(std::vector<row_state>& rows) {
     }
 }
 
+void donikian_sampler::begin_frame(double decay) {
+  if (decay >= 1) return;
+  float g = float(decay);
+  for (float& v : pixel_sum) v *= g;
+  for (float& v : pixel_count) v *= g;
+  for (float& v : block_sum) v *= g;
+  for (float& v : block_count) v *= g;
+}
+
 donikian_sampler make_donikian_sampler(const light_tree_data& tree, const light_data& lights, bound_sampler deeper,
                                        int width, int height, const donikian_params& params,
                                        const region_params& regions, const bbox3f& scene_bounds) {

@@ -6,6 +6,7 @@
 //   light_choice sample(const context&, double u_select, double u_inner) const   (53-bit uniforms)
 //   float pmf(const context&, int light) const      exactly the probability sample() gives `light`
 //   void end_pass()                                  between passes (non-learning samplers)
+//   void begin_frame(double decay)                   animations: scale learned statistics by `decay` (else no-op)
 //   static constexpr bool learns; learners also have S::row_state, record(row_state&, const nee_event&)
 //   and learn(std::vector<row_state>&) called between passes with the rows in image order.
 // Invariant (unbiasedness): every light that can contribute at a point has pmf > 0 there.

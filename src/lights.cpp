@@ -38,6 +38,12 @@ light_data build_lights(const scene_data& scene) {
   return l;
 }
 
+void set_sun_direction(light_data& l, vec3f direction) {
+  if (l.sun == invalid_id) return;
+  l.sun_dir = normalize(normalize(direction));  // scene_desc's normalisation, then build_lights'
+  l.sun_frame = make_frame(l.sun_dir);
+}
+
 light_sample sample_light_point(const light_data& l, const scene_data& scene, int light, vec3f x, float u,
                                 float v) {
   light_sample s;

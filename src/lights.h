@@ -31,6 +31,9 @@ struct light_data {
 
 // Collects the emitters of a scene.
 light_data build_lights(const scene_data& scene);
+// Points the sun (if any) along `direction` as a scene file states it (normalised exactly as loading and
+// build_lights do), keeping everything else; for animations.
+void set_sun_direction(light_data& lights, vec3f direction);
 
 // A point (or, for the sun, a direction) sampled on one light as seen from a shading point.
 struct light_sample {

@@ -171,8 +171,15 @@ int pass_size(int pass, int done) {
 render_result render(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
                      const render_params& params) {
   render_result result;
-  result.width = params.width;
-  result.height = params.height;
+  render_params one = params;
+  one.frames = 1;
+  light_data copy = lights;
+  render_frames(scene, bvh, copy, one, [&](int, const render_result& r) { result = r; });
+  return result;
+}
+
+void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lights, const render_params& params,
+                   const std::function<void(int, const render_result&)>& on_frame) {
   render_inputs in;
   in.scene = &scene;
   in.bvh = &bvh;
@@ -180,16 +187,30 @@ render_result render(const scene_data& scene, const bvh_data& bvh, const light_d
   in.camera = make_camera(scene.camera, params.width, params.height);
   in.max_depth = params.max_depth;
   in.seed = params.seed;
+  int frames = std::max(1, params.frames);
   auto t0 = clock_type::now();
   light_tree_data tree;
   if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
   light_sampler sampler = make_light_sampler(params.sampler, in, tree);
-  result.setup_seconds = seconds_since(t0);
-  std::visit([&](auto& s) { render_with(in, s, params, result); }, sampler);
-  result.sampler_bytes = sampler_memory_bytes(sampler);
-  if (auto* b = std::get_if<bound_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
-  if (auto* b = std::get_if<bayes_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
-  return result;
+  double setup = seconds_since(t0);
+  for (int frame = 0; frame < frames; frame++) {
+    render_result result;
+    result.width = params.width;
+    result.height = params.height;
+    result.setup_seconds = frame == 0 ? setup : 0.0;
+    render_params fp = params;
+    if (!params.frame_references.empty()) fp.reference = params.frame_references[size_t(frame)];
+    if (frame > 0) {
+      set_sun_direction(lights, animated_sun_direction(scene.sun, frame, frames));
+      std::visit([&](auto& s) { s.begin_frame(params.frame_decay); }, sampler);
+    }
+    std::visit([&](auto& s) { render_with(in, s, fp, result); }, sampler);
+    result.sampler_bytes = sampler_memory_bytes(sampler);
+    if (auto* b = std::get_if<bound_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
+    if (auto* b = std::get_if<bayes_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
+    on_frame(frame, result);
+    if (result.interrupted) return;
+  }
 }
 
 image_data film_image(const render_result& r) {

@@ -29,6 +29,9 @@ struct render_params {
   sampler_params sampler;
   const image_data* reference = nullptr;  // error is measured after every pass when set
   bool progress = false;      // progress bar on stderr
+  int frames = 1;             // animation frames (the sun moves from sun.direction to sun.direction_end)
+  double frame_decay = 0.5;   // learned statistics are scaled by this at the start of every frame after the first
+  std::vector<const image_data*> frame_references;  // per frame (overrides `reference` when not empty)
 };
 
 // One completed pass.
@@ -62,6 +65,13 @@ int pass_size(int pass, int done);
 // Renders the scene.
 render_result render(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
                      const render_params& params);
+// Renders params.frames frames of an animation in which the sun moves along the great circle from
+// sun.direction to sun.direction_end; the light sampler (and what it learned) carries over from frame to
+// frame, its statistics scaled by params.frame_decay at each frame start. Every frame uses the same seed and
+// pass schedule, so frame k of a non-learning sampler equals a single render with that frame's sun. Calls
+// on_frame(k, result) after each frame; stops after an interrupted frame (its result says so).
+void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lights, const render_params& params,
+                   const std::function<void(int, const render_result&)>& on_frame);
 // The film's mean image (zero when no sample completed).
 image_data film_image(const render_result& r);
 

@@ -97,13 +97,19 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
 }
 
 void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
-  check_keys(ctx, j, "sun", {"direction", "irradiance", "angular_diameter_deg"});
+  check_keys(ctx, j, "sun", {"direction", "irradiance", "angular_diameter_deg", "direction_end"});
   if (!j.contains("direction") || !j.contains("irradiance"))
     ctx.fail("sun", "\"sun\" needs \"direction\" and \"irradiance\"");
   sun.enabled = true;
   vec3f d = get_vec3(ctx, j["direction"], "direction");
   if (!(length(d) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
   sun.direction = normalize(d);
+  if (j.contains("direction_end")) {
+    vec3f e = get_vec3(ctx, j["direction_end"], "direction_end");
+    if (!(length(e) > 0)) ctx.fail("direction_end", "sun \"direction_end\" must be a non-zero vector");
+    sun.direction_end = normalize(e);
+    sun.animated = true;
+  }
   sun.irradiance = get_vec3(ctx, j["irradiance"], "irradiance");
   if (sun.irradiance.x < 0 || sun.irradiance.y < 0 || sun.irradiance.z < 0)
     ctx.fail("irradiance", "sun \"irradiance\" must not be negative");
@@ -188,6 +194,25 @@ scene_desc load_scene_desc(const std::string& path) {
     desc.two_sided_emitters = root["two_sided_emitters"].get<bool>();
   }
   return desc;
+}
+
+vec3f animated_sun_direction(const sun_params& sun, int frame, int frames) {
+  if (!sun.animated || frames <= 1 || frame == 0) return sun.direction;
+  float t = float(frame) / float(frames - 1);
+  vec3f a = sun.direction, b = sun.direction_end;
+  float cos_ab = clampf(dot(a, b), -1.0f, 1.0f);
+  float angle = std::acos(cos_ab);
+  vec3f d;
+  if (angle < 1e-6f) {
+    d = a * (1 - t) + b * t;
+  } else {
+    // Spherical interpolation; for opposite directions pick any great circle through a.
+    vec3f perp = b - a * cos_ab;
+    if (!(length(perp) > 1e-6f)) perp = cross(a, std::fabs(a.x) < 0.9f ? vec3f{1, 0, 0} : vec3f{0, 1, 0});
+    perp = normalize(perp);
+    d = a * std::cos(t * angle) + perp * std::sin(t * angle);
+  }
+  return normalize(d);
 }
 
 camera_params frame_bounds(const bbox3f& bounds, float fov_y_deg, float aspect) {

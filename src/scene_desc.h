@@ -21,6 +21,8 @@ struct camera_params {
 // A distant disk light. direction points from the scene toward the sun (unit length after parsing).
 struct sun_params {
   bool enabled = false;
+  bool animated = false;            // direction_end given (render --frames moves the sun to it)
+  vec3f direction_end = {0, 1, 0};  // unit, the direction at the last frame of an animation
   vec3f direction = {0, 1, 0};
   vec3f irradiance = {0, 0, 0};
   float angular_diameter_deg = 0.53f;
@@ -40,6 +42,11 @@ struct scene_desc {
 
 // Reads a .json scene file or wraps a bare .obj; throws input_error naming the file (and line) on problems.
 scene_desc load_scene_desc(const std::string& path);
+
+// The sun direction of frame `frame` of `frames`, as a scene file would state it: the unit direction a fraction
+// frame / (frames - 1) of the way along the great circle from direction to direction_end. (Rendering the frame
+// applies the same normalisation as loading that scene file, so both give the same image.)
+vec3f animated_sun_direction(const sun_params& sun, int frame, int frames);
 
 // The camera of a bare OBJ: looks at the centre of `bounds` from the +z side, whole box in view.
 camera_params frame_bounds(const bbox3f& bounds, float fov_y_deg, float aspect);

@@ -19,6 +19,7 @@ struct uniform_sampler {
   }
   float pmf(const context&, int) const { return count > 0 ? 1.0f / float(count) : 0.0f; }
   void end_pass() {}
+  void begin_frame(double) {}
 };
 
 // Lights proportional to emitted power.
@@ -34,6 +35,7 @@ struct power_sampler {
   }
   float pmf(const context&, int light) const { return float(discrete_pmf(dist, light)); }
   void end_pass() {}
+  void begin_frame(double) {}
 };
 
 }  // namespace bl

@@ -1,0 +1,118 @@
+// Animations (render --frames): the sun moves from sun.direction to sun.direction_end. Frame k of a
+// non-learning sampler equals, bit for bit, a single render of a scene file stating that frame's sun; a
+// learning sampler's frame 0 does too, its later frames (which start from the decayed statistics of the earlier
+// ones) agree statistically with a single render, and animations are deterministic across thread counts.
+#include "file_io.h"
+#include "image_io.h"
+#include "metrics.h"
+#include "scene_desc.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+#include <cstdio>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+// A floor, a wall that shadows part of it, a small lamp and a sun that swings over the wall.
+struct anim_scene {
+  temp_dir dir;
+  std::string obj = dir / "a.obj";
+  anim_scene() {
+    write_text(obj,
+               "mtllib a.mtl\n"
+               "v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\n"
+               "v -3 0 0\nv 3 0 0\nv 3 2 0\nv -3 2 0\n"
+               "v -0.3 2.5 1\nv 0.3 2.5 1\nv 0.3 2.5 1.6\nv -0.3 2.5 1.6\n"
+               "usemtl floor\nf 1 4 3 2\nf 5 6 7 8\n"
+               "usemtl lamp\nf 9 10 11 12\n");
+    write_text(dir / "a.mtl", "newmtl floor\nKd 0.6 0.6 0.6\nnewmtl lamp\nKd 0 0 0\nKe 20 20 20\n");
+  }
+  // A scene file with the given sun direction (and optionally an end direction).
+  std::string scene(const std::string& name, vec3f sun, const vec3f* end) {
+    char buf[1024];
+    std::string end_json;
+    if (end) {
+      std::snprintf(buf, sizeof buf, ", \"direction_end\": [%.9g, %.9g, %.9g]", end->x, end->y, end->z);
+      end_json = buf;
+    }
+    std::snprintf(buf, sizeof buf,
+                  "{\"mesh\": \"a.obj\", \"camera\": {\"eye\": [0, 4, 5], \"target\": [0, 0, 0]},"
+                  " \"image\": {\"width\": 24, \"height\": 18}, \"render\": {\"spp\": 4, \"max_depth\": 2},"
+                  " \"sun\": {\"direction\": [%.9g, %.9g, %.9g], \"irradiance\": [5, 5, 5]%s}}",
+                  sun.x, sun.y, sun.z, end_json.c_str());
+    std::string path = dir / name;
+    write_text(path, buf);
+    return path;
+  }
+};
+
+const vec3f sun_start = {0.6f, 0.5f, -0.6f}, sun_end = {-0.5f, 0.6f, 0.6f};
+
+}  // namespace
+
+TEST_CASE("each frame of a non learning sampler equals a single render with that frame's sun", "[animation]") {
+  anim_scene a;
+  std::string anim = a.scene("anim.json", sun_start, &sun_end);
+  scene_desc desc = load_scene_desc(anim);
+  const int frames = 4;
+  for (const char* s : {"power", "bvh", "bound"}) {
+    auto r = run_bayeslight("render " + anim + " --sampler " + s + " --frames 4 --quiet -o " + (a.dir / "f_%02d.pfm"));
+    INFO(s << "\n" << r.output);
+    REQUIRE(r.status == 0);
+    for (int k = 0; k < frames; k++) {
+      vec3f d = animated_sun_direction(desc.sun, k, frames);
+      std::string single = k == 0 ? anim : a.scene("single.json", d, nullptr);
+      REQUIRE(run_bayeslight("render " + single + " --sampler " + s + " --quiet -o " + (a.dir / "s.pfm")).status == 0);
+      char name[32];
+      std::snprintf(name, sizeof name, "f_%02d.pfm", k);
+      INFO("frame " << k);
+      CHECK(bit_identical(read_image(a.dir / name), read_image(a.dir / "s.pfm")));
+    }
+  }
+  // The first and last frames have the start and end suns.
+  CHECK(length(animated_sun_direction(desc.sun, 0, frames) - normalize(sun_start)) < 1e-6f);
+  CHECK(length(animated_sun_direction(desc.sun, frames - 1, frames) - normalize(sun_end)) < 1e-6f);
+}
+
+TEST_CASE("learning samplers animate deterministically and agree with single renders", "[animation]") {
+  anim_scene a;
+  std::string anim = a.scene("anim.json", sun_start, &sun_end);
+  scene_desc desc = load_scene_desc(anim);
+  for (const char* s : {"bayes", "donikian"}) {
+    INFO(s);
+    std::string base = " --sampler " + std::string(s) + " --frames 3 --quiet --spp 64";
+    REQUIRE(run_bayeslight("render " + anim + base + " --threads 1 -o " + (a.dir / "t1_%d.pfm")).status == 0);
+    REQUIRE(run_bayeslight("render " + anim + base + " --threads 2 -o " + (a.dir / "t2_%d.pfm")).status == 0);
+    for (int k = 0; k < 3; k++)
+      CHECK(read_file(a.dir / ("t1_" + std::to_string(k) + ".pfm")) == read_file(a.dir / ("t2_" + std::to_string(k) + ".pfm")));
+    // Frame 0 starts from nothing learned: exactly the single render.
+    REQUIRE(run_bayeslight("render " + anim + " --sampler " + s + " --quiet --spp 64 -o " + (a.dir / "s0.pfm")).status == 0);
+    CHECK(bit_identical(read_image(a.dir / "t1_0.pfm"), read_image(a.dir / "s0.pfm")));
+    // The last frame started from decayed statistics: same expectation as a fresh render of its sun. Pixel
+    // means of the two images (independent seeds) must agree within 4.4 standard errors (99.999%).
+    std::string single = a.scene("single.json", animated_sun_direction(desc.sun, 2, 3), nullptr);
+    REQUIRE(run_bayeslight("render " + single + " --sampler " + s + " --quiet --spp 64 --seed 7 -o " + (a.dir / "s2.pfm")).status == 0);
+    image_data x = read_image(a.dir / "t1_2.pfm"), y = read_image(a.dir / "s2.pfm");
+    std::vector<double> dx;
+    for (size_t i = 0; i < x.pixels.size(); i += 3) dx.push_back(double(x.pixels[i]) - double(y.pixels[i]));
+    mean_se m = mean_and_se(dx);
+    double level = 0;
+    for (size_t i = 0; i < y.pixels.size(); i += 3) level += y.pixels[i];
+    level /= double(y.pixels.size() / 3);
+    INFO("mean difference " << m.mean << " +- " << m.se << " image mean " << level);
+    CHECK(m.se < 0.02 * level);
+    CHECK(std::fabs(m.mean) < 4.4 * m.se);
+  }
+}
+
+TEST_CASE("frame patterns are required for animated outputs", "[animation]") {
+  anim_scene a;
+  std::string anim = a.scene("anim.json", sun_start, &sun_end);
+  auto r = run_bayeslight("render " + anim + " --frames 3 --quiet -o " + (a.dir / "plain.pfm"));
+  CHECK(r.status == 2);
+  CHECK(r.output.find("frame pattern") != std::string::npos);
+}
