@@ -1,0 +1,272 @@
+// compare: render rounds, per-sampler statistics (mean curves, equal-time error, speed-ups, time to a target
+// error) and the text of curves.csv, summary.md and error_vs_time.svg.
+// Numbers in summary.md are derived from the same pass records curves.csv prints, in run order, so the
+// summary can be checked against the CSV.
+#include "compare.h"
+
+#include "errors.h"
+#include "file_io.h"
+#include "svg_plot.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+
+namespace bl {
+
+namespace fs = std::filesystem;
+
+// printf into a std::string.
+template <class... Args>
+static std::string format(const char* fmt, Args... args) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, fmt, args...);
+  return buf;
+}
+
+// Path of a file in the output directory.
+static std::string out_path(const compare_params& p, const std::string& name) {
+  return (fs::path(p.out_dir) / name).string();
+}
+
+compare_data run_comparison(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
+                            const image_data& reference, const compare_params& params) {
+  compare_data data;
+  data.equal_time = params.render.time_budget > 0;
+  for (sampler_kind k : params.samplers) data.samplers.push_back({k, {}, {}});
+  // Rounds: every sampler once per round, so slow drifts of the machine (clock, heat) affect all alike.
+  for (int run = 1; run <= params.runs && data.signal == 0; run++) {
+    for (compare_sampler& s : data.samplers) {
+      render_params rp = params.render;
+      rp.sampler.kind = s.kind;
+      rp.seed = params.render.seed + uint64_t(run - 1);
+      rp.reference = &reference;
+      render_result r = render(scene, bvh, lights, rp);
+      compare_run cr;
+      cr.run = run;
+      cr.seed = rp.seed;
+      cr.spp = r.spp;
+      cr.seconds = r.seconds;
+      cr.setup_seconds = r.setup_seconds;
+      cr.interrupted = r.interrupted;
+      cr.log = r.log;
+      if (run == 1 && r.spp > 0) s.image = film_image(r);
+      if (!params.quiet && !r.log.empty())
+        std::fprintf(stderr, "compare: %s run %d/%d (seed %llu): %d spp in %.3f s, relMSE %.4e\n",
+                     sampler_name(s.kind), run, params.runs, (unsigned long long)cr.seed, r.spp, r.seconds,
+                     r.log.back().error.relmse);
+      s.runs.push_back(std::move(cr));
+      if (r.interrupted || interrupt_signal() != 0) {
+        data.signal = interrupt_signal() != 0 ? interrupt_signal() : SIGINT;
+        break;
+      }
+    }
+  }
+  return data;
+}
+
+double time_to_reach(const std::vector<double>& seconds, const std::vector<double>& relmse, double target) {
+  size_t n = std::min(seconds.size(), relmse.size());
+  for (size_t i = 0; i < n; i++) {
+    if (!(relmse[i] <= target)) continue;
+    if (i == 0) return seconds[0];
+    double t0 = seconds[i - 1], t1 = seconds[i], e0 = relmse[i - 1], e1 = relmse[i];
+    if (!(t0 > 0 && t1 > t0 && e1 > 0 && target > 0 && e0 > target)) return t1;
+    // Straight line between the two passes on log-log axes: log t = log t0 + (log target - log e0) * slope.
+    double slope = (std::log(t1) - std::log(t0)) / (std::log(e1) - std::log(e0));
+    return std::exp(std::log(t0) + (std::log(target) - std::log(e0)) * slope);
+  }
+  return -1;
+}
+
+std::vector<compare_stats> comparison_stats(const compare_data& data) {
+  std::vector<compare_stats> all;
+  for (const compare_sampler& s : data.samplers) {
+    compare_stats st;
+    std::vector<const compare_run*> runs;
+    size_t passes = 0;
+    for (const compare_run& r : s.runs)
+      if (!r.log.empty()) runs.push_back(&r), passes = std::max(passes, r.log.size());
+    st.runs = int(runs.size());
+    if (runs.empty()) {
+      all.push_back(st);
+      continue;
+    }
+    double k = double(runs.size());
+    for (size_t i = 0; i < passes; i++) {
+      double t = 0, e = 0;
+      for (const compare_run* r : runs) {
+        const pass_record& p = r->log[std::min(i, r->log.size() - 1)];
+        t += p.seconds;
+        e += p.error.relmse;
+      }
+      st.curve_seconds.push_back(t / k);
+      st.curve_relmse.push_back(e / k);
+    }
+    st.seconds = st.curve_seconds.back();
+    st.relmse = st.curve_relmse.back();
+    st.spp_min = st.spp_max = runs[0]->spp;
+    double var = 0;
+    for (const compare_run* r : runs) {
+      st.spp_min = std::min(st.spp_min, r->spp);
+      st.spp_max = std::max(st.spp_max, r->spp);
+      double d = r->log.back().error.relmse - st.relmse;
+      var += d * d;
+      st.setup_seconds += r->setup_seconds / k;
+    }
+    st.relmse_sd = runs.size() > 1 ? std::sqrt(var / (k - 1)) : 0;
+    all.push_back(st);
+  }
+  if (all.empty() || all[0].runs == 0) return all;
+  const compare_stats& base = all[0];
+  for (compare_stats& st : all) {
+    if (st.runs == 0) {
+      st.speedup = NAN;
+      continue;
+    }
+    double num = data.equal_time ? base.relmse : base.relmse * base.seconds;
+    double den = data.equal_time ? st.relmse : st.relmse * st.seconds;
+    st.speedup = den > 0 && std::isfinite(num) && std::isfinite(den) ? num / den : NAN;
+    st.time_to_target = time_to_reach(st.curve_seconds, st.curve_relmse, base.relmse);
+  }
+  return all;
+}
+
+std::string comparison_csv(const compare_data& data) {
+  std::string s = "sampler,run,seed,pass,spp,seconds,relmse,mse\n";
+  for (const compare_sampler& cs : data.samplers)
+    for (const compare_run& r : cs.runs)
+      for (const pass_record& p : r.log)
+        s += format("%s,%d,%llu,%d,%d,%.6f,%.9g,%.9g\n", sampler_name(cs.kind), r.run, (unsigned long long)r.seed,
+                    p.pass, p.spp, p.seconds, p.error.relmse, p.error.mse);
+  return s;
+}
+
+// "—" (U+2014), the table's mark for a value that does not exist.
+static const char* const dash = "\xe2\x80\x94";
+
+std::string comparison_summary(const compare_data& data, const compare_params& p) {
+  std::vector<compare_stats> stats = comparison_stats(data);
+  const render_params& rp = p.render;
+  std::string base = p.samplers.empty() ? "" : sampler_name(p.samplers[0]);
+  std::string s = "# Sampler comparison: " + p.scene_path + "\n\n";
+  s += data.equal_time ? format("Equal time: %g s of rendering per sampler and run", rp.time_budget)
+                       : format("Equal samples: %d spp per sampler and run", rp.spp);
+  s += format(" | %dx%d pixels | max depth %d | ", rp.width, rp.height, rp.max_depth);
+  s += p.runs == 1 ? format("1 run (seed %llu)", (unsigned long long)rp.seed)
+                   : format("%d runs (seeds %llu to %llu)", p.runs, (unsigned long long)rp.seed,
+                            (unsigned long long)(rp.seed + uint64_t(p.runs - 1)));
+  s += rp.threads > 0 ? format(" | %d threads\n\n", rp.threads) : std::string(" | threads: all cores\n\n");
+  s += (p.reference_note.empty() ? "reference: " + p.reference_path : p.reference_note) + "\n\n";
+  if (data.signal != 0)
+    s += format("**Interrupted** by signal %d: the table covers the passes completed before it.\n\n", data.signal);
+
+  std::string target = stats.empty() || stats[0].runs == 0 ? std::string("?") : format("%.4e", stats[0].relmse);
+  s += "| sampler | spp | seconds | relMSE | speed-up vs " + base + (data.equal_time ? " (equal time)" : " (efficiency)") +
+       " | time to relMSE " + target + " (s) | setup (s) |\n";
+  s += "|:--|--:|--:|--:|--:|--:|--:|\n";
+  for (size_t i = 0; i < stats.size(); i++) {
+    const compare_stats& st = stats[i];
+    s += std::string("| ") + sampler_name(data.samplers[i].kind) + " | ";
+    if (st.runs == 0) {
+      s += std::string(dash) + " | " + dash + " | " + dash + " | " + dash + " | " + dash + " | " + dash + " |\n";
+      continue;
+    }
+    s += st.spp_min == st.spp_max ? format("%d", st.spp_max) : format("%d\xe2\x80\x93%d", st.spp_min, st.spp_max);
+    s += format(" | %.4g | %.4e", st.seconds, st.relmse);
+    if (st.runs > 1) s += format(" \xc2\xb1 %.2e", st.relmse_sd);
+    s += std::isfinite(st.speedup) ? format(" | %.2f", st.speedup) : std::string(" | ") + dash;
+    s += st.time_to_target >= 0 ? format(" | %.4g", st.time_to_target) : std::string(" | ") + dash;
+    s += format(" | %.3g |\n", st.setup_seconds);
+  }
+
+  s += "\n- **relMSE**: mean over pixels and RGB channels of (x \xe2\x88\x92 r)\xc2\xb2 / (r\xc2\xb2 + 0.01) after the "
+       "final pass";
+  s += p.runs > 1 ? format("; mean \xc2\xb1 standard deviation over the %d runs.\n", p.runs) : std::string(".\n");
+  if (data.equal_time)
+    s += "- **speed-up** at equal time: relMSE of " + base + " / relMSE of the sampler, both after the same time "
+         "budget (each render stops after the first whole pass that reaches it).\n";
+  else
+    s += "- **speed-up** at equal spp: the efficiency ratio (relMSE \xc3\x97 seconds of " + base +
+         ") / (relMSE \xc3\x97 seconds of the sampler), which is the equal-time speed-up when relMSE falls as "
+         "1/time; the time-to-target column measures it without that assumption.\n";
+  s += "- **time to relMSE**: the first time the sampler's mean curve reaches " + base +
+       "'s final relMSE, interpolated log-log between passes; " + dash + ": not reached.\n";
+  s += "- **seconds**: render wall time (passes and learning), mean over runs; it excludes the setup column (light "
+       "tree, regions) and error computation. Every pass is in curves.csv; error_vs_time.svg plots the mean curves.\n";
+  s += format("- **images**: `<sampler>.exr` is the render of run 1 (seed %llu); `<sampler>_error.png` shows its "
+              "per-pixel relative error |x \xe2\x88\x92 r| / (|r| + 0.1), averaged over RGB, on the viridis ramp with "
+              "the fixed logarithmic range %g (dark purple, and below) to %g (yellow, and above).\n",
+              (unsigned long long)rp.seed, double(p.error_image.min_error), double(p.error_image.max_error));
+  return s;
+}
+
+std::string comparison_svg(const compare_data& data, const compare_params& p) {
+  std::vector<compare_stats> stats = comparison_stats(data);
+  std::vector<plot_series> series;
+  for (size_t i = 0; i < stats.size(); i++)
+    series.push_back({sampler_name(data.samplers[i].kind), stats[i].curve_seconds, stats[i].curve_relmse});
+  loglog_plot_params pp;
+  pp.title = "relMSE against time: " + fs::path(p.scene_path).filename().string() +
+             (p.runs > 1 ? format(" (mean of %d runs)", p.runs) : std::string());
+  pp.x_label = "render time (s)";
+  pp.y_label = "relMSE";
+  pp.guide_label = "slope \xe2\x88\x92" "1 (1/t)";
+  return loglog_plot_svg(series, pp);
+}
+
+void write_comparison(const compare_data& data, const compare_params& p, const image_data& reference) {
+  for (const compare_sampler& s : data.samplers) {
+    if (s.image.pixels.empty()) continue;
+    write_image(out_path(p, std::string(sampler_name(s.kind)) + ".exr"), s.image);
+    write_error_image(out_path(p, std::string(sampler_name(s.kind)) + "_error.png"), s.image, reference, p.error_image);
+  }
+  write_file_atomic(out_path(p, "curves.csv"), comparison_csv(data));
+  write_file_atomic(out_path(p, "error_vs_time.svg"), comparison_svg(data, p));
+  write_file_atomic(out_path(p, "summary.md"), comparison_summary(data, p));
+}
+
+// Creates the output directory when missing (its parent must exist); throws output_error when it cannot be
+// used.
+static void make_output_dir(const std::string& dir) {
+  std::error_code ec;
+  if (!fs::exists(dir, ec)) {
+    if (!fs::create_directory(dir, ec) && !fs::is_directory(dir))
+      throw output_error("cannot create directory " + dir + ": " + ec.message());
+  }
+  if (!fs::is_directory(dir, ec)) throw output_error("cannot write into " + dir + ": not a directory");
+  if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write into " + dir + ": directory is not writable");
+}
+
+int run_compare(const scene_desc& desc, const compare_params& params) {
+  const render_params& rp = params.render;
+  image_data reference = read_image(params.reference_path);
+  if (reference.width != rp.width || reference.height != rp.height)
+    throw input_error(params.reference_path, "reference is " + std::to_string(reference.width) + "x" +
+                                                 std::to_string(reference.height) + " but the render is " +
+                                                 std::to_string(rp.width) + "x" + std::to_string(rp.height));
+  scene_data scene = build_scene(desc, float(rp.width) / float(rp.height));
+  if (scene.mesh.dropped_degenerate > 0)
+    std::fprintf(stderr, "%s: dropped %d degenerate (zero-area) triangles\n", desc.mesh_path.c_str(),
+                 scene.mesh.dropped_degenerate);
+  bvh_data bvh = build_bvh(scene);
+  light_data lights = build_lights(scene);
+  if (lights.count == 0)
+    std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", params.scene_path.c_str());
+  make_output_dir(params.out_dir);
+
+  install_interrupt_handlers();
+  compare_data data = run_comparison(scene, bvh, lights, reference, params);
+  write_comparison(data, params, reference);
+  if (!params.quiet || data.signal != 0)
+    std::fprintf(stderr, "compare: %s -> %s (summary.md, curves.csv, error_vs_time.svg, <sampler>.exr, "
+                         "<sampler>_error.png)\n",
+                 data.signal != 0 ? "interrupted; wrote the passes completed so far" : "done", params.out_dir.c_str());
+  return data.signal != 0 ? 128 + data.signal : exit_ok;
+}
+
+}  // namespace bl

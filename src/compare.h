@@ -1,0 +1,95 @@
+// compare: the `compare` command — renders several light samplers for the same time (or spp) against a
+// reference, K runs each with seeds base, base+1, ..., and writes DIR/curves.csv, DIR/error_vs_time.svg,
+// DIR/summary.md, DIR/<sampler>.exr and DIR/<sampler>_error.png.
+// Invariants: the scene, BVH and lights are built once; renders never overlap in time (round r renders every
+// sampler in the given order, then round r+1), so their timings compare; every output is written atomically;
+// summary.md's numbers are computed from exactly the pass records curves.csv lists.
+#pragma once
+
+#include "bvh.h"
+#include "error_image.h"
+#include "lights.h"
+#include "render.h"
+#include "scene.h"
+#include "scene_desc.h"
+
+#include <string>
+#include <vector>
+
+namespace bl {
+
+// What a comparison renders and where it writes.
+struct compare_params {
+  std::vector<sampler_kind> samplers;  // in the order given; the first is the baseline of speed-ups
+  int runs = 1;                        // run r (1-based) uses seed render.seed + r - 1
+  render_params render;                // shared options: size, spp or time budget, depth, threads, sampler options
+  std::string scene_path;              // for the summary's title
+  std::string reference_path;
+  std::string reference_note;          // summary line about the reference (empty: "reference: FILE")
+  std::string out_dir;                 // created (one level) when missing
+  error_image_params error_image;
+  bool quiet = false;                  // no per-render lines on stderr
+};
+
+// One render of one sampler.
+struct compare_run {
+  int run = 1;  // 1-based
+  uint64_t seed = 0;
+  int spp = 0;
+  double seconds = 0, setup_seconds = 0;
+  bool interrupted = false;
+  std::vector<pass_record> log;  // every pass, with its error against the reference
+};
+
+// Every run of one sampler, and the render of its first run (written as DIR/<sampler>.exr).
+struct compare_sampler {
+  sampler_kind kind = sampler_kind::bayes;
+  std::vector<compare_run> runs;
+  image_data image;  // empty when the first run completed no pass
+};
+
+// The renders of a comparison.
+struct compare_data {
+  std::vector<compare_sampler> samplers;  // in the order given
+  bool equal_time = false;                // --time budget (else equal spp)
+  int signal = 0;                         // the SIGINT/SIGTERM that cut it short (0: complete)
+};
+
+// What summary.md and the plot report for one sampler (error and time of runs that completed a pass).
+struct compare_stats {
+  // Mean curve over runs: point i averages pass i of every run; a run with fewer passes (a --time budget
+  // reached sooner) contributes its final pass, so the last point is the mean of the runs' final passes.
+  std::vector<double> curve_seconds, curve_relmse;
+  int runs = 0;                      // runs with at least one pass
+  int spp_min = 0, spp_max = 0;      // final spp over runs
+  double seconds = 0;                // mean final render time
+  double relmse = 0, relmse_sd = 0;  // mean and sample standard deviation of the final relMSE
+  double setup_seconds = 0;          // mean setup time (light tree, regions; not in `seconds`)
+  double speedup = 0;                // against the first sampler (NaN when undefined)
+  double time_to_target = -1;        // seconds to reach the first sampler's final relMSE; < 0: not reached
+};
+
+// Renders every (run, sampler) one at a time; stops early on SIGINT/SIGTERM (data.signal).
+compare_data run_comparison(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
+                            const image_data& reference, const compare_params& params);
+// Statistics of every sampler. Speed-up: equal time: relMSE_first / relMSE; equal spp: the efficiency ratio
+// (relMSE x seconds)_first / (relMSE x seconds).
+std::vector<compare_stats> comparison_stats(const compare_data& data);
+// The first time a curve reaches `target`: log-log interpolation between the passes around the first point at
+// or below it (its time when it is the first point); -1 when no point reaches it.
+double time_to_reach(const std::vector<double>& seconds, const std::vector<double>& relmse, double target);
+
+// curves.csv: header `sampler,run,seed,pass,spp,seconds,relmse,mse`, one row per pass of every run.
+std::string comparison_csv(const compare_data& data);
+// summary.md: the table of SPEC.md's compare command and notes saying how each column is computed.
+std::string comparison_summary(const compare_data& data, const compare_params& params);
+// error_vs_time.svg: relMSE against seconds on log-log axes, the mean curve of each sampler.
+std::string comparison_svg(const compare_data& data, const compare_params& params);
+// Writes every output into params.out_dir (which must exist), each atomically.
+void write_comparison(const compare_data& data, const compare_params& params, const image_data& reference);
+
+// The whole command: reads and checks the reference (input_error), builds the scene once, creates the output
+// directory, renders, writes; returns the exit status (0, or 128 + signal when interrupted).
+int run_compare(const scene_desc& desc, const compare_params& params);
+
+}  // namespace bl
