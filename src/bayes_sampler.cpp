@@ -59,6 +59,7 @@ void bayes_sampler::begin_frame(double decay) {
 }
 
 void bayes_sampler::learn(std::vector<row_state>& rows) {
+  if (frozen) return;
   merge_rows(stats, rows, params, params.hierarchy > 0 ? &regions.pair_parent : nullptr);
   std::vector<const region_requests*> r;
   for (const row_state& row : rows) r.push_back(&row.requests);

@@ -23,6 +23,7 @@ struct bayes_sampler {
   bayes_stats stats;
   bayes_params params;
   float sun_sin = 0, sun_cos = 1;
+  bool frozen = false;  // oracle mode: statistics and regions no longer change
 
   void prepare(context& ctx, const shade_point& sp) const;
   light_choice sample(const context& ctx, double u, double u_inner) const {

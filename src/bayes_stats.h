@@ -26,6 +26,7 @@ struct bayes_params {
   bool distance_regression = true;  // false: z = Y, no 1/d^2 model (ablation)
   bool prior = true;             // false: plug-in sample moments, the naive adaptive method (ablation)
   double decay = 1;              // statistics scale per animation frame (1: keep everything)
+  int oracle_spp = 0;            // > 0: learn for this many spp first (independent seed), then freeze (oracle mode)
   double hierarchy = 4;          // concentration of a fine pair's Beta prior on p0, centred on its coarse parent's
                                  // posterior mean (0: no hierarchy, every pair uses Beta(a0, b0))
 };

@@ -257,6 +257,9 @@ void add_render_options(CLI::App* r, render_options& o) {
       ->check(CLI::PositiveNumber)->group(bg);
   r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1)")
       ->check(CLI::Range(1.000001, 1e9))->group(bg);
+  r->add_option("--bayes-oracle", o.bayes.oracle_spp,
+                "Oracle mode: learn for this many spp first (own seed, not timed), then freeze the statistics")
+      ->check(CLI::Range(0, 1 << 30))->group(bg);
   r->add_option("--bayes-hierarchy", o.bayes.hierarchy,
                 "Concentration of a fine region's Beta prior on p0, centred on its coarse parent's posterior (0 = off)")
       ->check(CLI::Range(0.0, 1e9))->group(bg);

@@ -192,6 +192,20 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   light_tree_data tree;
   if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
   light_sampler sampler = make_light_sampler(params.sampler, in, tree);
+  if (auto* b = std::get_if<bayes_sampler>(&sampler); b && params.sampler.bayes.oracle_spp > 0) {
+    // Oracle mode: learn for oracle_spp spp on random streams independent of the render's (its own seed),
+    // then freeze. Using the render's own streams would let a sample's pmf depend on its own outcome.
+    render_inputs learn_in = in;
+    learn_in.seed = mix64(params.seed ^ 0x6f7261636c65ull);
+    render_params lp = params;
+    lp.spp = params.sampler.bayes.oracle_spp;
+    lp.time_budget = 0;
+    lp.reference = nullptr;
+    lp.progress = false;
+    render_result scratch;
+    render_with(learn_in, *b, lp, scratch);
+    b->frozen = true;
+  }
   double setup = seconds_since(t0);
   for (int frame = 0; frame < frames; frame++) {
     render_result result;
