@@ -3,6 +3,7 @@
 #include "cli.h"
 
 #include "bvh.h"
+#include "checkpoint.h"
 #include "compare.h"
 #include "errors.h"
 #include "file_io.h"
@@ -21,6 +22,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <climits>
 #include <csignal>
 #include <cstdio>
@@ -53,6 +55,11 @@ struct render_options {
   std::string bayes_pmf = "second-moment";
   int frames = 1;
   double frame_decay = 0.5;
+  std::string checkpoint;
+  double checkpoint_every = 30;
+  std::string resume;
+  int stop_after_passes = 0;  // testing aid: raise SIGINT after this many passes
+  int kill_after_passes = 0;  // testing aid: raise SIGKILL right after the checkpoint of this pass
 };
 
 // Options of `diff`.
@@ -150,8 +157,13 @@ int run_render(const render_options& o) {
     if (!o.reference.empty() && !is_frame_pattern(o.reference))
       throw usage_error("--frames needs a frame pattern in --reference: " + o.reference);
   }
+  if (o.frames > 1 && (!o.checkpoint.empty() || !o.resume.empty()))
+    throw usage_error("--checkpoint and --resume are not supported with --frames");
   for (const std::string& out : outputs) check_output_path(frame_path(out, 0));
   if (!o.log.empty()) check_output_path(frame_path(o.log, 0));
+  if (!o.checkpoint.empty()) check_output_path(o.checkpoint);
+  std::string resume_bytes;
+  if (!o.resume.empty()) resume_bytes = read_file(o.resume);
 
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
@@ -167,6 +179,21 @@ int run_render(const render_options& o) {
   light_data lights = build_lights(scene);
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", o.scene.c_str());
+
+  uint64_t fingerprint = render_fingerprint(scene, params);
+  if (!o.resume.empty())
+    params.restore = [&](render_result& r, light_sampler& s) { decode_checkpoint(resume_bytes, o.resume, fingerprint, r, s); };
+  auto last_write = std::chrono::steady_clock::now();
+  params.on_pass = [&](const render_result& r, const light_sampler& s, bool last) {
+    if (!last && o.stop_after_passes > 0 && r.passes == o.stop_after_passes) std::raise(SIGINT);
+    if (o.checkpoint.empty()) return;
+    auto now = std::chrono::steady_clock::now();
+    bool due = std::chrono::duration<double>(now - last_write).count() >= o.checkpoint_every;
+    if (!last && !due && r.passes != o.kill_after_passes) return;
+    write_file_atomic(o.checkpoint, encode_checkpoint(fingerprint, r, s));
+    last_write = now;
+    if (!last && o.kill_after_passes > 0 && r.passes == o.kill_after_passes) std::raise(SIGKILL);
+  };
 
   install_interrupt_handlers();
   bool interrupted = false;
@@ -222,6 +249,17 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
                 "and --reference then take a frame pattern such as out_%04d.exr")
       ->check(CLI::Range(1, 100000));
+  r->add_option("--checkpoint", o.checkpoint,
+                "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
+                "and at the end); --resume continues it");
+  r->add_option("--checkpoint-every", o.checkpoint_every, "Seconds between checkpoints (default 30; 0: every pass)")
+      ->check(CLI::Range(0.0, 1e9));
+  r->add_option("--resume", o.resume,
+                "Continue the render saved in FILE (same scene and options; --spp may be larger)");
+  r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes")
+      ->group("");
+  r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")
+      ->group("");
   r->add_option("--frame-decay", o.frame_decay,
                 "Animations: learned statistics are scaled by this at each new frame (default 0.5; 1 keeps all)")
       ->check(CLI::Range(0.0, 1.0));

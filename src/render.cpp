@@ -99,12 +99,17 @@ error_metrics film_error(const std::vector<double>& film, int spp, const image_d
   return compute_error(img.data(), ref.pixels.data(), img.size());
 }
 
-// The pass loop for one sampler type.
+// The pass loop for one sampler type; continues from the passes already in `result` (a resumed render).
+// after_pass is called after every completed pass.
 template <class Sampler>
-void render_with(const render_inputs& in, Sampler& sampler, const render_params& params, render_result& result) {
+void render_with(const render_inputs& in, Sampler& sampler, const render_params& params, render_result& result,
+                 const std::function<void()>& after_pass = {}) {
   int w = params.width, h = params.height;
   size_t n = size_t(w) * size_t(h) * 3;
-  result.film.assign(n, 0.0);
+  if (result.film.size() != n) {
+    result.film.assign(n, 0.0);
+    result.spp = result.passes = 0;
+  }
   std::vector<double> pass_sum(n, 0.0);
   using rows_type = std::conditional_t<Sampler::learns, pass_rows<Sampler>, pass_rows_none>;
   rows_type rows;
@@ -120,8 +125,9 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   progress_bar bar(progress, params.progress);
 
   const int target = params.time_budget > 0 ? INT_MAX : params.spp;
-  int done = 0;
-  for (int pass = 0; done < target; pass++) {
+  int done = result.spp;
+  progress.spp_done = done;
+  for (int pass = result.passes; done < target; pass++) {
     if (params.time_budget > 0 && result.seconds >= params.time_budget) break;
     if (g_signal.load() != 0) {
       result.interrupted = true;
@@ -156,6 +162,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
       rec.error = film_error(result.film, done, *params.reference);
     }
     result.log.push_back(rec);
+    if (after_pass) after_pass();
   }
 }
 
@@ -192,7 +199,12 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   light_tree_data tree;
   if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
   light_sampler sampler = make_light_sampler(params.sampler, in, tree);
-  if (auto* b = std::get_if<bayes_sampler>(&sampler); b && params.sampler.bayes.oracle_spp > 0) {
+  render_result restored;
+  restored.width = params.width;
+  restored.height = params.height;
+  if (params.restore) params.restore(restored, sampler);
+  bool resuming = !restored.film.empty();
+  if (auto* b = std::get_if<bayes_sampler>(&sampler); b && params.sampler.bayes.oracle_spp > 0 && !resuming) {
     // Oracle mode: learn for oracle_spp spp on random streams independent of the render's (its own seed),
     // then freeze. Using the render's own streams would let a sample's pmf depend on its own outcome.
     render_inputs learn_in = in;
@@ -208,7 +220,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   }
   double setup = seconds_since(t0);
   for (int frame = 0; frame < frames; frame++) {
-    render_result result;
+    render_result result = frame == 0 && resuming ? restored : render_result{};
     result.width = params.width;
     result.height = params.height;
     result.setup_seconds = frame == 0 ? setup : 0.0;
@@ -218,7 +230,10 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
       set_sun_direction(lights, animated_sun_direction(scene.sun, frame, frames));
       std::visit([&](auto& s) { s.begin_frame(params.frame_decay); }, sampler);
     }
-    std::visit([&](auto& s) { render_with(in, s, fp, result); }, sampler);
+    std::function<void()> after_pass;
+    if (params.on_pass) after_pass = [&] { params.on_pass(result, sampler, false); };
+    std::visit([&](auto& s) { render_with(in, s, fp, result, after_pass); }, sampler);
+    if (params.on_pass) params.on_pass(result, sampler, true);
     result.sampler_bytes = sampler_memory_bytes(sampler);
     if (auto* b = std::get_if<bound_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
     if (auto* b = std::get_if<bayes_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;

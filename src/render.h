@@ -18,6 +18,8 @@
 
 namespace bl {
 
+struct render_result;
+
 // Options of one render.
 struct render_params {
   int width = 640, height = 480;
@@ -32,6 +34,11 @@ struct render_params {
   int frames = 1;             // animation frames (the sun moves from sun.direction to sun.direction_end)
   double frame_decay = 0.5;   // learned statistics are scaled by this at the start of every frame after the first
   std::vector<const image_data*> frame_references;  // per frame (overrides `reference` when not empty)
+  // Called after every completed pass (last = false) and once when the render ends (last = true), with the state
+  // of the completed passes: what a checkpoint saves.
+  std::function<void(const render_result&, const light_sampler&, bool last)> on_pass;
+  // Called once the sampler is built, before the first pass: restores a checkpointed state (resume).
+  std::function<void(render_result&, light_sampler&)> restore;
 };
 
 // One completed pass.

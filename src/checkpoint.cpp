@@ -1,0 +1,266 @@
+// checkpoint: binary (de)serialisation of render state and sampler state, and the fingerprint.
+// Layout: magic, version, fingerprint, sampler kind, pass state, log, film, sampler state, checksum; all integers
+// and floats little-endian as in memory (x86-64 only, like the rest of the renderer's determinism promise).
+#include "checkpoint.h"
+
+#include "errors.h"
+#include "rng.h"
+
+#include <cstring>
+#include <type_traits>
+
+namespace bl {
+
+namespace {
+
+constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
+constexpr uint32_t version = 1;
+
+// Running 64-bit hash of bytes (8 at a time through mix64).
+struct hasher {
+  uint64_t h = 0x243f6a8885a308d3ull;
+  void bytes(const void* data, size_t n) {
+    const unsigned char* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; i += 8) {
+      uint64_t w = 0;
+      std::memcpy(&w, p + i, std::min<size_t>(8, n - i));
+      h = mix64(h ^ w);
+    }
+    h = mix64(h ^ n);
+  }
+  template <class T>
+  void value(const T& v) {
+    static_assert(std::is_arithmetic_v<T>, "hash fields one by one (no struct padding)");
+    bytes(&v, sizeof v);
+  }
+  void vec(vec3f v) { value(v.x), value(v.y), value(v.z); }
+  template <class T>
+  void column(const std::vector<T>& v) {
+    bytes(v.data(), v.size() * sizeof(T));
+  }
+};
+
+// Appends plain values and columns to a byte string.
+struct writer {
+  std::string out;
+  template <class T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>, "plain data only");
+    out.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  template <class T>
+  void column(const std::vector<T>& v) {
+    value(uint64_t(v.size()));
+    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+};
+
+// Reads what writer wrote; every read is bounds-checked and failures name the file.
+struct reader {
+  const std::string& in;
+  const std::string& path;
+  size_t pos = 0;
+  [[noreturn]] void fail(const std::string& what) const { throw input_error(path, "corrupt checkpoint: " + what); }
+  template <class T>
+  T value() {
+    T v;
+    if (in.size() - pos < sizeof v) fail("truncated");
+    std::memcpy(&v, in.data() + pos, sizeof v);
+    pos += sizeof v;
+    return v;
+  }
+  template <class T>
+  std::vector<T> column(size_t expected = size_t(-1)) {
+    uint64_t n = value<uint64_t>();
+    if (n > (in.size() - pos) / sizeof(T)) fail("truncated column");
+    if (expected != size_t(-1) && n != expected) fail("column of unexpected size");
+    std::vector<T> v(n);
+    std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
+    pos += n * sizeof(T);
+    return v;
+  }
+};
+
+void write_regions(writer& w, const region_state& s) {
+  w.column(s.key);
+  w.column(s.cut_offset);
+  w.column(s.cut_size);
+  w.column(s.pair_offset);
+  w.column(s.parent);
+  w.column(s.cut_nodes);
+  w.column(s.pair_parent);
+  w.value(s.pairs);
+  w.column(s.pending);
+  w.value(uint64_t(s.pending_count));
+}
+
+void read_regions(reader& r, region_state& s) {
+  s.key = r.column<uint64_t>();
+  size_t n = s.key.size();
+  s.cut_offset = r.column<int>(n);
+  s.cut_size = r.column<int>(n);
+  s.pair_offset = r.column<int>(n);
+  s.parent = r.column<int>(n);
+  s.cut_nodes = r.column<int>();
+  s.pair_parent = r.column<int>();
+  s.pairs = r.value<int64_t>();
+  s.pending = r.column<region_slot>();
+  s.pending_count = size_t(r.value<uint64_t>());
+  if (s.pairs != int64_t(s.pair_parent.size())) r.fail("pair count");
+  for (size_t i = 0; i < n; i++)
+    if (s.cut_offset[i] < 0 || s.cut_size[i] < 0 || size_t(s.cut_offset[i]) + size_t(s.cut_size[i]) > s.cut_nodes.size() ||
+        s.pair_offset[i] < 0 || int64_t(s.pair_offset[i]) + s.cut_size[i] > s.pairs)
+      r.fail("region layout");
+  if (!s.pending.empty() && (s.pending.size() & (s.pending.size() - 1)) != 0) r.fail("pending table size");
+  // The lookup table is rebuilt from the keys (its layout does not matter, its answers do).
+  size_t want = 16;
+  while (want < 2 * n) want *= 2;
+  s.table.assign(want, region_slot{empty_region_key, invalid_id});
+  for (size_t i = 0; i < n; i++) {
+    size_t mask = want - 1, h = size_t(mix64(s.key[i])) & mask;
+    while (s.table[h].key != empty_region_key) h = (h + 1) & mask;
+    s.table[h] = {s.key[i], int(i)};
+  }
+}
+
+void write_sampler(writer& w, const light_sampler& ls) {
+  if (auto* b = std::get_if<bound_sampler>(&ls)) write_regions(w, b->regions);
+  if (auto* b = std::get_if<bayes_sampler>(&ls)) {
+    write_regions(w, b->regions);
+    w.column(b->stats.n0);
+    w.column(b->stats.n1);
+    w.column(b->stats.mean);
+    w.column(b->stats.m2);
+    w.value(uint8_t(b->frozen));
+  }
+  if (auto* d = std::get_if<donikian_sampler>(&ls)) {
+    write_regions(w, d->deeper.regions);
+    w.column(d->pixel_sum);
+    w.column(d->pixel_count);
+    w.column(d->block_sum);
+    w.column(d->block_count);
+  }
+}
+
+void read_sampler(reader& r, light_sampler& ls) {
+  if (auto* b = std::get_if<bound_sampler>(&ls)) read_regions(r, b->regions);
+  if (auto* b = std::get_if<bayes_sampler>(&ls)) {
+    read_regions(r, b->regions);
+    size_t pairs = size_t(b->regions.pairs);
+    b->stats.n0 = r.column<double>(pairs);
+    b->stats.n1 = r.column<double>(pairs);
+    b->stats.mean = r.column<double>(pairs);
+    b->stats.m2 = r.column<double>(pairs);
+    b->frozen = r.value<uint8_t>() != 0;
+    // Coefficients and weights are functions of the statistics: recompute them (bit for bit the same).
+    b->stats.coeffs.resize(pairs);
+    b->stats.weight.resize(pairs);
+    for (size_t i = 0; i < pairs; i++) update_coeffs(b->stats, i, b->params);
+    refresh_weights(b->stats, &b->regions.pair_parent, b->params);
+  }
+  if (auto* d = std::get_if<donikian_sampler>(&ls)) {
+    read_regions(r, d->deeper.regions);
+    d->pixel_sum = r.column<float>(d->pixel_sum.size());
+    d->pixel_count = r.column<float>(d->pixel_count.size());
+    d->block_sum = r.column<float>(d->block_sum.size());
+    d->block_count = r.column<float>(d->block_count.size());
+  }
+}
+
+}  // namespace
+
+uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
+  hasher h;
+  const mesh_data& m = scene.mesh;
+  h.column(m.positions);
+  h.column(m.normals);
+  h.column(m.texcoords);
+  h.column(m.tri_positions);
+  h.column(m.tri_normals);
+  h.column(m.tri_texcoords);
+  h.column(m.tri_materials);
+  for (const material_data& mat : m.materials) {
+    h.vec(mat.kd), h.vec(mat.ks), h.vec(mat.ke), h.value(mat.ns);
+    h.value(mat.kd_texture), h.value(mat.alpha_texture);
+  }
+  for (const texture_data& t : m.textures) {
+    h.value(t.width), h.value(t.height);
+    h.column(t.rgb);
+    h.column(t.alpha);
+  }
+  h.vec(scene.camera.eye), h.vec(scene.camera.target), h.vec(scene.camera.up), h.value(scene.camera.fov_y_deg);
+  h.value(scene.sun.enabled), h.vec(scene.sun.direction), h.vec(scene.sun.irradiance);
+  h.value(scene.sun.angular_diameter_deg), h.value(scene.two_sided_emitters);
+  h.value(p.width), h.value(p.height), h.value(p.max_depth), h.value(p.seed), h.value(int(p.sampler.kind));
+  const region_params& r = p.sampler.regions;
+  h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
+  h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs);
+  const bayes_params& b = p.sampler.bayes;
+  h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
+  h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
+  h.value(b.oracle_spp);
+  const donikian_params& d = p.sampler.donikian;
+  h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
+  return h.h;
+}
+
+std::string encode_checkpoint(uint64_t fingerprint, const render_result& result, const light_sampler& sampler) {
+  writer w;
+  w.out.append(magic, sizeof magic);
+  w.value(version);
+  w.value(fingerprint);
+  w.value(uint32_t(sampler.index()));
+  w.value(result.width), w.value(result.height), w.value(result.passes), w.value(result.spp);
+  w.value(result.seconds);
+  w.value(result.stats);
+  w.value(uint64_t(result.log.size()));
+  for (const pass_record& p : result.log) {
+    w.value(p.pass), w.value(p.spp), w.value(p.seconds), w.value(uint8_t(p.has_error));
+    w.value(p.error.relmse), w.value(p.error.mse), w.value(p.error.maxabs);
+  }
+  w.column(result.film);
+  write_sampler(w, sampler);
+  hasher h;
+  h.bytes(w.out.data(), w.out.size());
+  w.value(h.h);
+  return w.out;
+}
+
+void decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
+                       render_result& result, light_sampler& sampler) {
+  if (bytes.size() < sizeof magic + 8 || std::memcmp(bytes.data(), magic, sizeof magic) != 0)
+    throw input_error(path, "not a bayeslight checkpoint");
+  hasher h;
+  h.bytes(bytes.data(), bytes.size() - 8);
+  uint64_t stored;
+  std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
+  if (stored != h.h) throw input_error(path, "corrupt checkpoint: checksum mismatch");
+  std::string body = bytes.substr(0, bytes.size() - 8);
+  reader r{body, path, sizeof magic};
+  if (r.value<uint32_t>() != version) throw input_error(path, "checkpoint of another bayeslight version");
+  if (r.value<uint64_t>() != fingerprint)
+    throw input_error(path, "checkpoint was written for a different scene or different render options");
+  if (r.value<uint32_t>() != uint32_t(sampler.index())) r.fail("sampler kind");
+  int w = r.value<int>(), hgt = r.value<int>();
+  if (w != result.width || hgt != result.height) r.fail("image size");
+  result.passes = r.value<int>();
+  result.spp = r.value<int>();
+  result.seconds = r.value<double>();
+  result.stats = r.value<path_stats>();
+  uint64_t n = r.value<uint64_t>();
+  if (n > uint64_t(1) << 24) r.fail("log length");
+  result.log.clear();
+  for (uint64_t i = 0; i < n; i++) {
+    pass_record p;
+    p.pass = r.value<int>(), p.spp = r.value<int>(), p.seconds = r.value<double>();
+    p.has_error = r.value<uint8_t>() != 0;
+    p.error.relmse = r.value<double>(), p.error.mse = r.value<double>(), p.error.maxabs = r.value<double>();
+    result.log.push_back(p);
+  }
+  result.film = r.column<double>(size_t(w) * size_t(hgt) * 3);
+  if (result.passes < 0 || result.spp < 0) r.fail("pass state");
+  read_sampler(r, sampler);
+  if (r.pos != body.size()) r.fail("trailing data");
+}
+
+}  // namespace bl

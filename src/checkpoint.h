@@ -1,0 +1,29 @@
+// checkpoint: saving and restoring a render between passes (--checkpoint / --resume). A checkpoint holds the
+// film sums, the pass count, the per-pass log, the counters, the light sampler's learned state and a fingerprint
+// of the scene and every option that changes the image. Invariant: rendering is deterministic and the pass
+// schedule depends only on the pass index, so a resumed render reaches exactly the bits of an uninterrupted one.
+// Files are written atomically and end with a checksum; anything malformed is an input_error.
+#pragma once
+
+#include "light_sampler.h"
+#include "render.h"
+#include "scene.h"
+
+#include <cstdint>
+#include <string>
+
+namespace bl {
+
+// Fingerprint of what a resumed render must share with the one that wrote the checkpoint: the loaded scene
+// (geometry, materials, textures, camera, sun) and the options that affect pixels (size, depth, seed, sampler
+// and its parameters). The spp target and time budget are not part of it: a render may be resumed further.
+uint64_t render_fingerprint(const scene_data& scene, const render_params& params);
+
+// Serialises a completed-pass state: the result so far and the sampler's learned state.
+std::string encode_checkpoint(uint64_t fingerprint, const render_result& result, const light_sampler& sampler);
+// Restores a state written by encode_checkpoint into a freshly built sampler of the same kind and the result;
+// throws input_error naming `path` when the data are malformed or were written for another scene/options.
+void decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
+                       render_result& result, light_sampler& sampler);
+
+}  // namespace bl

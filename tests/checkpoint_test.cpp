@@ -1,0 +1,85 @@
+// Resumable renders: a render interrupted by SIGINT (checkpoint written on the way out) or killed by SIGKILL
+// (after a checkpoint) and resumed to the same spp is byte-identical to an uninterrupted one, for the learning
+// samplers too; a resume with another scene or other options, or from a corrupt file, is refused (exit 3).
+#include "file_io.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+std::string base_args(const std::string& sampler) {
+  return "render " + source_path("data/living_room/path.json") + " --sampler " + sampler +
+         " --width 40 --height 30 --spp 30 --quiet";
+}
+
+}  // namespace
+
+TEST_CASE("interrupted and killed renders resume to the same bytes", "[checkpoint]") {
+  temp_dir d;
+  for (const char* s : {"bound", "donikian", "bayes"}) {
+    INFO(s);
+    std::string full = d / "full.pfm";
+    REQUIRE(run_bayeslight(base_args(s) + " -o " + full).status == 0);
+    // SIGINT after 9 passes: the checkpoint of the completed passes is written on the way out.
+    std::string ck = d / "ck.bin", part = d / "part.pfm", out = d / "resumed.pfm";
+    auto r1 = run_bayeslight(base_args(s) + " -o " + part + " --checkpoint " + ck + " --stop-after-passes 9");
+    CHECK(r1.status == 130);
+    REQUIRE(std::filesystem::exists(ck));
+    auto r2 = run_bayeslight(base_args(s) + " -o " + out + " --resume " + ck);
+    INFO(r2.output);
+    REQUIRE(r2.status == 0);
+    CHECK(read_file(out) == read_file(full));
+    // SIGKILL right after the checkpoint of pass 11 (no chance to write anything else).
+    std::string ck2 = d / "ck2.bin", out2 = d / "resumed2.pfm";
+    auto r3 = run_bayeslight(base_args(s) + " -o " + (d / "k.pfm") + " --checkpoint " + ck2 +
+                             " --checkpoint-every 1000 --kill-after-passes 11");
+    CHECK(r3.status == 128 + 9);
+    REQUIRE(std::filesystem::exists(ck2));
+    REQUIRE(run_bayeslight(base_args(s) + " -o " + out2 + " --resume " + ck2).status == 0);
+    CHECK(read_file(out2) == read_file(full));
+  }
+}
+
+TEST_CASE("a finished render can be resumed further", "[checkpoint]") {
+  temp_dir d;
+  std::string ck = d / "ck.bin";
+  REQUIRE(run_bayeslight(base_args("bayes") + " -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
+  std::string more = "render " + source_path("data/living_room/path.json") +
+                     " --sampler bayes --width 40 --height 30 --spp 45 --quiet";
+  REQUIRE(run_bayeslight(more + " -o " + (d / "resumed.pfm") + " --resume " + ck).status == 0);
+  REQUIRE(run_bayeslight(more + " -o " + (d / "full.pfm")).status == 0);
+  CHECK(read_file(d / "resumed.pfm") == read_file(d / "full.pfm"));
+}
+
+TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[checkpoint]") {
+  temp_dir d;
+  std::string ck = d / "ck.bin";
+  REQUIRE(run_bayeslight(base_args("bayes") + " -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
+  for (const std::string& other : {base_args("bayes") + " --seed 5", base_args("bayes") + " --max-depth 2",
+                                   base_args("bound"), base_args("bayes") + " --bayes-b0 2",
+                                   "render " + source_path("data/cornell/path.json") +
+                                       " --sampler bayes --width 40 --height 30 --spp 30 --quiet"}) {
+    auto r = run_bayeslight(other + " -o " + (d / "x.pfm") + " --resume " + ck);
+    INFO(other << "\n" << r.output);
+    CHECK(r.status == 3);
+    CHECK(r.output.find("ck.bin") != std::string::npos);
+    CHECK(!std::filesystem::exists(d / "x.pfm"));
+  }
+  // A flipped byte, a truncated file, a file that is not a checkpoint.
+  std::string bytes = read_file(ck);
+  std::string flipped = bytes;
+  flipped[flipped.size() / 2] ^= 0x40;
+  write_text(d / "flipped.bin", flipped);
+  write_text(d / "short.bin", bytes.substr(0, bytes.size() / 3));
+  write_text(d / "junk.bin", "hello");
+  for (const char* bad : {"flipped.bin", "short.bin", "junk.bin", "missing.bin"}) {
+    auto r = run_bayeslight(base_args("bayes") + " -o " + (d / "x.pfm") + " --resume " + (d / bad));
+    INFO(bad << "\n" << r.output);
+    CHECK(r.status == 3);
+    CHECK(r.output.find(bad) != std::string::npos);
+  }
+}
