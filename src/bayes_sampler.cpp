@@ -3,6 +3,8 @@
 
 #include "cluster_bounds.h"
 
+#include <xmmintrin.h>
+
 namespace bl {
 
 void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
@@ -23,13 +25,41 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
                                               inv_d2[ctx.tree_count]);
   double w[max_cut_entries], b[max_cut_entries];
   double sum_w = 0, sum_b = 0;
-  for (int j = 0; j < ctx.count; j++) {
-    double bound = double(num[j]) * inv_d2[j];
-    double g = params.distance_regression ? inv_d2[j] : 1.0;
-    w[j] = eval_weight(stats.weight[base + size_t(j)], params, scale * bound, g);
-    b[j] = bound;
-    sum_w += w[j];
-    sum_b += b[j];
+  if (params.second_moment) {
+    // Four clusters at a time in float: w = sqrt(max((w2 v + w1 g) v + w0 g^2, wc v^2)), v = scale * bound.
+    alignas(16) float wf[max_cut_entries + 3];
+    const __m128 scale4 = _mm_set1_ps(float(scale)), zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    for (int j0 = 0; j0 < ctx.count; j0 += 4) {
+      __m128 c[4];
+      for (int k = 0; k < 4; k++)
+        c[k] = _mm_loadu_ps(&stats.weight[base + size_t(std::min(j0 + k, ctx.count - 1))].w2);
+      _MM_TRANSPOSE4_PS(c[0], c[1], c[2], c[3]);  // now w2, w1, w0, wc of the four pairs
+      __m128 inv = _mm_loadu_ps(inv_d2 + j0);
+      __m128 bound = _mm_mul_ps(_mm_loadu_ps(num + j0), inv);
+      __m128 v = _mm_mul_ps(scale4, bound);
+      __m128 g = params.distance_regression ? inv : one;
+      __m128 val = _mm_add_ps(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(c[0], v), _mm_mul_ps(c[1], g)), v),
+                              _mm_mul_ps(_mm_mul_ps(c[2], g), g));
+      __m128 wv = _mm_sqrt_ps(_mm_max_ps(val, _mm_mul_ps(_mm_mul_ps(c[3], v), v)));
+      wv = _mm_and_ps(_mm_cmpgt_ps(v, zero), wv);  // a cluster that cannot reach the point weighs 0
+      _mm_store_ps(wf + j0, wv);
+      _mm_storeu_ps(num + j0, bound);  // keep the bound for mixing and the fallback
+    }
+    for (int j = 0; j < ctx.count; j++) {
+      w[j] = wf[j];
+      b[j] = num[j];
+      sum_w += w[j];
+      sum_b += b[j];
+    }
+  } else {
+    for (int j = 0; j < ctx.count; j++) {
+      double bound = double(num[j]) * inv_d2[j];
+      double g = params.distance_regression ? inv_d2[j] : 1.0;
+      w[j] = eval_weight(stats.weight[base + size_t(j)], params, scale * bound, g);
+      b[j] = bound;
+      sum_w += w[j];
+      sum_b += b[j];
+    }
   }
   // Defensive mixing with the bound pmf (always a little for the naive ablation, which can starve clusters).
   double eps = params.prior ? params.epsilon : std::max(params.epsilon, 1e-3);

@@ -25,6 +25,7 @@ struct bayes_sampler {
   float sun_sin = 0, sun_cos = 1;
   bool frozen = false;  // oracle mode: statistics and regions no longer change
 
+  void locate(context& ctx, const shade_point& sp) const { locate_region(ctx, regions, sp); }
   void prepare(context& ctx, const shade_point& sp) const;
   light_choice sample(const context& ctx, double u, double u_inner) const {
     return sample_cut(ctx, *tree, *lights, u, u_inner);

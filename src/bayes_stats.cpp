@@ -4,6 +4,9 @@
 #include "rng.h"
 
 #include <algorithm>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <cmath>
 
 namespace bl {
@@ -111,7 +114,10 @@ void bayes_row::add(int pair, double z) {
 }
 
 void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p) {
-  for (size_t i = 0; i < s.weight.size(); i++) fold_weight(s, i, parents ? (*parents)[i] : invalid_id, p);
+  // Every pair independently (the result does not depend on how the range is split).
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, s.weight.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); i++) fold_weight(s, i, parents ? (*parents)[i] : invalid_id, p);
+  });
 }
 
 // Chan's parallel update of pair i with an accumulator.
@@ -129,19 +135,23 @@ static void merge_accum(bayes_stats& s, size_t i, const pair_accum& a) {
 void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
                 const std::vector<int>* parents) {
   auto parent_of = [parents](int pair) { return parents ? (*parents)[size_t(pair)] : invalid_id; };
+  // Fold in row order (sequential: the order fixes the floating-point result), collecting each touched pair once.
+  std::vector<uint8_t> seen(s.n0.size(), 0);
+  std::vector<int> touched;
+  auto touch = [&](int pair) {
+    if (!seen[size_t(pair)]) seen[size_t(pair)] = 1, touched.push_back(pair);
+  };
   for (const bayes_row& row : rows)
     for (const pair_accum& a : row.acc) {
       merge_accum(s, size_t(a.pair), a);
+      touch(a.pair);
       int up = parent_of(a.pair);
-      if (up != invalid_id) merge_accum(s, size_t(up), a);
+      if (up != invalid_id) merge_accum(s, size_t(up), a), touch(up);
     }
-  // Coefficients once per touched pair (a pair may appear in many rows; recomputing is idempotent).
-  for (const bayes_row& row : rows)
-    for (const pair_accum& a : row.acc) {
-      update_coeffs(s, size_t(a.pair), p);
-      int up = parent_of(a.pair);
-      if (up != invalid_id) update_coeffs(s, size_t(up), p);
-    }
+  // Coefficients of the touched pairs, in parallel (each depends on its own statistics only).
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k < r.end(); k++) update_coeffs(s, size_t(touched[k]), p);
+  });
 }
 
 double posterior_weight(const bayes_params& p, double bound, double scale, double d, double n0, double n1,

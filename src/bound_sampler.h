@@ -20,6 +20,7 @@ struct bound_sampler {
   region_state regions;
   float sun_sin = 0, sun_cos = 1;
 
+  void locate(context& ctx, const shade_point& sp) const { locate_region(ctx, regions, sp); }
   void prepare(context& ctx, const shade_point& sp) const;
   light_choice sample(const context& ctx, double u, double u_inner) const {
     return sample_cut(ctx, *tree, *lights, u, u_inner);

@@ -23,6 +23,7 @@ struct bvh_sampler {
   const light_data* lights = nullptr;
   float sun_sin = 0, sun_cos = 1;  // sun disk half-angle
 
+  void locate(context&, const shade_point&) const {}
   void prepare(context& ctx, const shade_point& sp) const;
   light_choice sample(const context& ctx, double u, double) const;
   float pmf(const context& ctx, int light) const;

@@ -10,6 +10,7 @@
 #include "image_io.h"
 #include "lights.h"
 #include "metrics.h"
+#include "profile.h"
 #include "progress.h"
 #include "render.h"
 #include "report.h"
@@ -245,24 +246,6 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--width", o.width, "Image width in pixels")->check(CLI::Range(1ll, max_side));
   r->add_option("--height", o.height, "Image height in pixels")->check(CLI::Range(1ll, max_side));
   r->add_flag("--quiet", o.quiet, "No progress bar or summary");
-  r->add_option("--frames", o.frames,
-                "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
-                "and --reference then take a frame pattern such as out_%04d.exr")
-      ->check(CLI::Range(1, 100000));
-  r->add_option("--checkpoint", o.checkpoint,
-                "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
-                "and at the end); --resume continues it");
-  r->add_option("--checkpoint-every", o.checkpoint_every, "Seconds between checkpoints (default 30; 0: every pass)")
-      ->check(CLI::Range(0.0, 1e9));
-  r->add_option("--resume", o.resume,
-                "Continue the render saved in FILE (same scene and options; --spp may be larger)");
-  r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes")
-      ->group("");
-  r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")
-      ->group("");
-  r->add_option("--frame-decay", o.frame_decay,
-                "Animations: learned statistics are scaled by this at each new frame (default 0.5; 1 keeps all)")
-      ->check(CLI::Range(0.0, 1.0));
   // Regions, cuts and the ablation switches of the adaptive samplers.
   const char* grp = "Regions and light cuts (bound, bayes)";
   r->add_option("--grid", o.regions.grid, "Region cells along the shortest axis of the scene bounds (default 64)")
@@ -312,7 +295,51 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("-o,--output", o.outputs, ".exr/.pfm (linear float RGB) or .png (8-bit sRGB); repeatable");
   r->add_option("--reference", o.reference, "Reference .exr/.pfm of the same size: error after every pass");
   r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse");
+  r->add_option("--frames", o.frames,
+                "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
+                "and --reference then take a frame pattern such as out_%04d.exr")
+      ->check(CLI::Range(1, 100000));
+  r->add_option("--checkpoint", o.checkpoint,
+                "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
+                "and at the end); --resume continues it");
+  r->add_option("--checkpoint-every", o.checkpoint_every, "Seconds between checkpoints (default 30; 0: every pass)")
+      ->check(CLI::Range(0.0, 1e9));
+  r->add_option("--resume", o.resume,
+                "Continue the render saved in FILE (same scene and options; --spp may be larger)");
+  r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes")
+      ->group("");
+  r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")
+      ->group("");
+  r->add_option("--frame-decay", o.frame_decay,
+                "Animations: learned statistics are scaled by this at each new frame (default 0.5; 1 keeps all)")
+      ->check(CLI::Range(0.0, 1.0));
   add_render_options(r, o);
+}
+
+// ---- profile: where the time of a render goes ----
+
+void add_profile_command(CLI::App& app, render_options& o) {
+  CLI::App* p = app.add_subcommand("profile", "Time the stages of a render (ns per NEE sample) against the raw "
+                                              "Embree shadow-ray limit on the same scene");
+  p->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required();
+  p->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)");
+  add_render_options(p, o);
+}
+
+int run_profile_command(const render_options& o) {
+  sampler_kind kind;
+  if (!parse_sampler_kind(o.sampler, kind))
+    throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
+  scene_desc desc = load_scene_desc(o.scene);
+  render_params params = resolve_params(o, desc, kind);
+  params.progress = false;
+  scene_data scene = build_scene(desc, float(params.width) / float(params.height));
+  bvh_data bvh = build_bvh(scene);
+  light_data lights = build_lights(scene);
+  install_interrupt_handlers();
+  std::string report = profile_render(scene, bvh, lights, params, o.scene + " with the " + o.sampler + " sampler");
+  std::fputs(report.c_str(), stdout);
+  return interrupt_signal() != 0 ? 128 + interrupt_signal() : exit_ok;
 }
 
 // ---- compare: equal-time (or equal-spp) comparison of samplers (compare.h does the work) ----
@@ -343,6 +370,8 @@ int run_compare_command(const compare_options& o) {
   }
   if (cp.samplers.empty()) throw usage_error("--samplers names no sampler");
   if ((o.render.spp > 0) == (o.render.time > 0)) throw usage_error("compare needs exactly one of --time and --spp");
+  if (o.render.frames > 1 || !o.render.checkpoint.empty() || !o.render.resume.empty())
+    throw usage_error("--frames, --checkpoint and --resume are options of render, not of compare");
   scene_desc desc = load_scene_desc(o.render.scene);
   cp.render = resolve_params(o.render, desc, cp.samplers[0]);
   cp.runs = o.runs;
@@ -364,11 +393,14 @@ int run_cli(int argc, char** argv) {
   compare_options copt;
   add_render_command(app, ro);
   add_compare_command(app, copt);
+  render_options popt;
+  add_profile_command(app, popt);
   CLI::App* diff = app.add_subcommand("diff", "Compare two images: relmse, mse, maxabs; 'identical' if bit-equal");
   diff->add_option("A", dopt.a, "Image (.exr/.pfm)")->required();
   diff->add_option("B", dopt.b, "Image (.exr/.pfm), the reference")->required();
   std::string first = argc >= 2 ? argv[1] : "";
-  if (!first.empty() && first[0] != '-' && first != "render" && first != "diff" && first != "compare") {
+  if (!first.empty() && first[0] != '-' && first != "render" && first != "diff" && first != "compare" &&
+      first != "profile") {
     std::fprintf(stderr, "bayeslight: error: unknown command \"%s\" (commands: render, diff, compare)\n"
                          "Run with --help for more information.\n", first.c_str());
     return exit_usage;
@@ -387,6 +419,7 @@ int run_cli(int argc, char** argv) {
     if (app.got_subcommand("render")) return run_render(ro);
     if (app.got_subcommand("diff")) return run_diff(dopt);
     if (app.got_subcommand("compare")) return run_compare_command(copt);
+    if (app.got_subcommand("profile")) return run_profile_command(popt);
   } catch (const usage_error& e) {
     std::fprintf(stderr, "bayeslight: error: %s\nRun with --help for more information.\n", e.what());
     return exit_usage;

@@ -71,16 +71,17 @@ compare_data run_comparison(const scene_data& scene, const bvh_data& bvh, const 
 
 double time_to_reach(const std::vector<double>& seconds, const std::vector<double>& relmse, double target) {
   size_t n = std::min(seconds.size(), relmse.size());
-  for (size_t i = 0; i < n; i++) {
-    if (!(relmse[i] <= target)) continue;
-    if (i == 0) return seconds[0];
-    double t0 = seconds[i - 1], t1 = seconds[i], e0 = relmse[i - 1], e1 = relmse[i];
-    if (!(t0 > 0 && t1 > t0 && e1 > 0 && target > 0 && e0 > target)) return t1;
-    // Straight line between the two passes on log-log axes: log t = log t0 + (log target - log e0) * slope.
-    double slope = (std::log(t1) - std::log(t0)) / (std::log(e1) - std::log(e0));
-    return std::exp(std::log(t0) + (std::log(target) - std::log(e0)) * slope);
-  }
-  return -1;
+  // The curve stays at or below the target from point i on; a dip of a noisy curve that rises again does not
+  // count as reaching it.
+  size_t i = n;
+  while (i > 0 && relmse[i - 1] <= target) i--;
+  if (i == n) return -1;
+  if (i == 0) return seconds[0];
+  double t0 = seconds[i - 1], t1 = seconds[i], e0 = relmse[i - 1], e1 = relmse[i];
+  if (!(t0 > 0 && t1 > t0 && e1 > 0 && target > 0 && std::isfinite(e0))) return t1;
+  // Straight line between the two passes on log-log axes: log t = log t0 + (log target - log e0) * slope.
+  double slope = (std::log(t1) - std::log(t0)) / (std::log(e1) - std::log(e0));
+  return std::exp(std::log(t0) + (std::log(target) - std::log(e0)) * slope);
 }
 
 std::vector<compare_stats> comparison_stats(const compare_data& data) {
@@ -166,7 +167,8 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
     s += format("**Interrupted** by signal %d: the table covers the passes completed before it.\n\n", data.signal);
 
   std::string target = stats.empty() || stats[0].runs == 0 ? std::string("?") : format("%.4e", stats[0].relmse);
-  s += "| sampler | spp | seconds | relMSE | speed-up vs " + base + (data.equal_time ? " (equal time)" : " (efficiency)") +
+  s += "| sampler | spp | seconds | relMSE | speed-up vs " + base +
+       (data.equal_time ? " (equal time)" : " (efficiency)") +
        " | time to relMSE " + target + " (s) | setup (s) |\n";
   s += "|:--|--:|--:|--:|--:|--:|--:|\n";
   for (size_t i = 0; i < stats.size(); i++) {
@@ -194,7 +196,7 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
     s += "- **speed-up** at equal spp: the efficiency ratio (relMSE \xc3\x97 seconds of " + base +
          ") / (relMSE \xc3\x97 seconds of the sampler), which is the equal-time speed-up when relMSE falls as "
          "1/time; the time-to-target column measures it without that assumption.\n";
-  s += "- **time to relMSE**: the first time the sampler's mean curve reaches " + base +
+  s += "- **time to relMSE**: the time from which the sampler's mean curve stays at or below " + base +
        "'s final relMSE, interpolated log-log between passes; " + dash + ": not reached.\n";
   s += "- **seconds**: render wall time (passes and learning), mean over runs; it excludes the setup column (light "
        "tree, regions) and error computation. Every pass is in curves.csv; error_vs_time.svg plots the mean curves.\n";

@@ -66,7 +66,7 @@ struct compare_stats {
   double relmse = 0, relmse_sd = 0;  // mean and sample standard deviation of the final relMSE
   double setup_seconds = 0;          // mean setup time (light tree, regions; not in `seconds`)
   double speedup = 0;                // against the first sampler (NaN when undefined)
-  double time_to_target = -1;        // seconds to reach the first sampler's final relMSE; < 0: not reached
+  double time_to_target = -1;        // seconds until it stays at or below the first sampler's final relMSE
 };
 
 // Renders every (run, sampler) one at a time; stops early on SIGINT/SIGTERM (data.signal).
@@ -75,8 +75,8 @@ compare_data run_comparison(const scene_data& scene, const bvh_data& bvh, const 
 // Statistics of every sampler. Speed-up: equal time: relMSE_first / relMSE; equal spp: the efficiency ratio
 // (relMSE x seconds)_first / (relMSE x seconds).
 std::vector<compare_stats> comparison_stats(const compare_data& data);
-// The first time a curve reaches `target`: log-log interpolation between the passes around the first point at
-// or below it (its time when it is the first point); -1 when no point reaches it.
+// The time from which a curve stays at or below `target`: log-log interpolation between the last point above
+// it and the next (the first point's time when every point is at or below); -1 when the last point is above.
 double time_to_reach(const std::vector<double>& seconds, const std::vector<double>& relmse, double target);
 
 // curves.csv: header `sampler,run,seed,pass,spp,seconds,relmse,mse`, one row per pass of every run.

@@ -48,6 +48,9 @@ struct donikian_sampler {
   float sun_sin = 0, sun_cos = 1;
 
   int clusters() const { return int(cut.size()); }
+  void locate(context& ctx, const shade_point& sp) const {
+    if (sp.depth > 1) deeper.locate(ctx, sp);
+  }
   void prepare(context& ctx, const shade_point& sp) const;
   light_choice sample(const context& ctx, double u, double u_inner) const {
     return sample_cut(ctx, *tree, *lights, u, u_inner);

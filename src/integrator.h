@@ -11,6 +11,7 @@
 #include "light_sampler_types.h"
 #include "lights.h"
 #include "material.h"
+#include "profile_timers.h"
 #include "rng.h"
 #include "sampling.h"
 #include "scene.h"
@@ -62,14 +63,16 @@ inline bool unoccluded(const render_inputs& in, const surface_point& sp, const l
 
 // Radiance of sample `sample` of pixel (x, y). `ctxs` are the light-selection contexts of the current and the
 // previous vertex (alternating by depth); the caller keeps them across samples of a row, so that samplers can
-// reuse per-point work between neighbouring samples (e.g. a region lookup).
-template <class Sampler, class Sink>
-vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample, path_stats& st,
-                 Sink& sink, typename Sampler::context (&ctxs)[2]) {
+// reuse per-point work between neighbouring samples (e.g. a region lookup). `tm` times the hot path's stages
+// (profile_timers.h; no_timers compiles every timer away).
+template <class Sampler, class Sink, class Timers>
+vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample,
+                       path_stats& st, Sink& sink, typename Sampler::context (&ctxs)[2], Timers& tm) {
   const scene_data& scene = *in.scene;
   const light_data& lights = *in.lights;
   int pixel = y * in.camera.width + x;
   uint64_t key = sample_key(in.seed, uint64_t(pixel), sample);
+  uint64_t t0 = tm.start();
   vertex_randoms cam = draw_vertex(key, 0);
   vec3f org = in.camera.eye;
   vec3f dir = camera_ray_dir(in.camera, float(x) + cam.u[dim_pixel_x], float(y) + cam.u[dim_pixel_y]);
@@ -79,7 +82,10 @@ vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, 
   bool prev_mis = false;           // the current ray was BSDF-sampled at a vertex that also ran weighted NEE
   float prev_bsdf_pdf = 0;
   for (int depth = 1;; depth++) {
+    if (depth > 1) t0 = tm.start();
     hit_info h = intersect(*in.bvh, org, dir);
+    tm.stop(depth == 1 ? prof_camera : prof_bounce, t0);
+    t0 = tm.start();
     if (h.tri == invalid_id) {
       if (in_sun_disk(lights, dir)) {
         float w = 1;
@@ -107,24 +113,44 @@ vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, 
       }
     }
     bsdf_data bsdf = make_bsdf(scene, sp);
-    if (is_black_bsdf(bsdf)) break;
+    if (is_black_bsdf(bsdf)) {
+      tm.stop(prof_shading, t0);
+      break;
+    }
     vertex_randoms r = draw_vertex(key, uint32_t(depth));
     bool last = depth >= in.max_depth;
     typename Sampler::context& ctx = ctxs[depth & 1];
-    sampler.prepare(ctx, shade_point{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth});
+    shade_point spt{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth};
+    tm.stop(prof_shading, t0);
+    if constexpr (Timers::enabled) {
+      // Profiles time the region lookup apart; prepare() then finds it cached.
+      t0 = tm.start();
+      sampler.locate(ctx, spt);
+      tm.stop(prof_region, t0);
+    }
+    t0 = tm.start();
+    sampler.prepare(ctx, spt);
+    tm.stop(prof_pmf, t0);
 
     // Next-event estimation.
+    t0 = tm.start();
     light_choice choice = sampler.sample(ctx, r.u53(dim_light_select, dim_light_select_lo),
                                          r.u53(dim_light_inner, dim_light_inner_lo));
+    tm.stop(prof_select, t0);
     if (choice.light != invalid_id && choice.prob > 0) {
       st.nee_samples++;
       float value = 0;
+      t0 = tm.start();
       light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, r.u[dim_light_u], r.u[dim_light_v]);
+      vec3f fc = ls.pdf > 0 ? eval_bsdf_cos(bsdf, wo, ls.wi) : vec3f{0, 0, 0};
+      tm.stop(prof_point, t0);
       if (ls.pdf > 0) {
-        vec3f fc = eval_bsdf_cos(bsdf, wo, ls.wi);
         if (!is_black(fc)) {
           st.shadow_rays++;
-          if (unoccluded(in, sp, ls)) {
+          t0 = tm.start();
+          bool visible = unoccluded(in, sp, ls);
+          tm.stop(prof_shadow, t0);
+          if (visible) {
             vec3f unweighted = fc * ls.le / ls.pdf;
             float w = last ? 1.0f : power_heuristic(choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
             radiance += beta * unweighted * (w / choice.prob);
@@ -133,21 +159,29 @@ vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, 
         }
       }
       st.nee_zero += value == 0;
-      if constexpr (Sampler::learns) sink.record(nee_event<typename Sampler::context>{&ctx, choice, value});
+      if constexpr (Sampler::learns) {
+        t0 = tm.start();
+        sink.record(nee_event<typename Sampler::context>{&ctx, choice, value});
+        tm.stop(prof_record, t0);
+      }
     }
     if (last) break;
 
     // BSDF continuation.
+    t0 = tm.start();
     bsdf_sample bs = sample_bsdf(bsdf, wo, r.u[dim_bsdf_lobe], r.u[dim_bsdf_u], r.u[dim_bsdf_v]);
-    if (!(bs.pdf > 0)) break;
-    vec3f fc = eval_bsdf_cos(bsdf, wo, bs.wi);
-    if (is_black(fc)) break;
-    beta = beta * fc / bs.pdf;
-    if (depth >= 3) {
-      float q = std::min(1.0f, max_component(beta));
-      if (!(r.u[dim_roulette] < q)) break;
-      beta = beta / q;
+    vec3f fc = bs.pdf > 0 ? eval_bsdf_cos(bsdf, wo, bs.wi) : vec3f{0, 0, 0};
+    bool go_on = bs.pdf > 0 && !is_black(fc);
+    if (go_on) {
+      beta = beta * fc / bs.pdf;
+      if (depth >= 3) {
+        float q = std::min(1.0f, max_component(beta));
+        go_on = r.u[dim_roulette] < q;
+        if (go_on) beta = beta / q;
+      }
     }
+    tm.stop(prof_continue, t0);
+    if (!go_on) break;
     prev_mis = true;
     prev_bsdf_pdf = bs.pdf;
     org = offset_ray_origin(scene, sp.p, sp.ng, bs.wi);
@@ -159,6 +193,14 @@ vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, 
     return {0, 0, 0};
   }
   return radiance;
+}
+
+// trace_path_timed without timers (renders).
+template <class Sampler, class Sink>
+vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample, path_stats& st,
+                 Sink& sink, typename Sampler::context (&ctxs)[2]) {
+  no_timers tm;
+  return trace_path_timed(in, sampler, x, y, sample, st, sink, ctxs, tm);
 }
 
 }  // namespace bl

@@ -2,6 +2,7 @@
 // sampler sees of a shading point, and what it returns.
 // The contract of a sampler type S (dispatched once per pass by std::visit, never per sample):
 //   S::context                               per-vertex scratch, filled by prepare (no allocation)
+//   void locate(context&, const shade_point&) const   the region lookup part of prepare (profiles time it apart)
 //   void prepare(context&, const shade_point&) const
 //   light_choice sample(const context&, double u_select, double u_inner) const   (53-bit uniforms)
 //   float pmf(const context&, int light) const      exactly the probability sample() gives `light`

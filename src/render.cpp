@@ -32,10 +32,12 @@ double seconds_since(clock_type::time_point t) {
 template <class Sampler>
 struct pass_rows {
   std::vector<path_stats> stats;
+  std::vector<cycle_timers> timers;  // profile renders only
   std::vector<typename Sampler::row_state> records;
 };
 struct pass_rows_none {
   std::vector<path_stats> stats;
+  std::vector<cycle_timers> timers;
 };
 
 // Hands a learning sampler's NEE events to its state of one row.
@@ -49,8 +51,9 @@ struct row_sink {
   }
 };
 
-// Renders samples [s0, s1) of every pixel into pass_sum; false when interrupted (the pass is then void).
-template <class Sampler, class Rows>
+// Renders samples [s0, s1) of every pixel into pass_sum; false when interrupted (the pass is then void). With
+// Profile, each row's stages are timed into rows.timers.
+template <bool Profile, class Sampler, class Rows>
 bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, std::vector<double>& pass_sum,
               Rows& rows, tbb::task_arena& arena, progress_counters& progress) {
   int w = in.camera.width, h = in.camera.height;
@@ -66,15 +69,17 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
         st = {};
         auto render_row = [&](auto& sink) {
           typename Sampler::context ctxs[2];
+          std::conditional_t<Profile, cycle_timers, no_timers> tm;
           for (int x = 0; x < w; x++) {
             double sum[3] = {0, 0, 0};
             for (int s = s0; s < s1; s++) {
-              vec3f l = trace_path(in, sampler, x, y, uint64_t(s), st, sink, ctxs);
+              vec3f l = trace_path_timed(in, sampler, x, y, uint64_t(s), st, sink, ctxs, tm);
               sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
             }
             double* out = &pass_sum[3 * (size_t(y) * w + x)];
             out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
           }
+          if constexpr (Profile) rows.timers[size_t(y)] = tm;
         };
         if constexpr (Sampler::learns) {
           auto& row = rows.records[size_t(y)];
@@ -114,6 +119,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   using rows_type = std::conditional_t<Sampler::learns, pass_rows<Sampler>, pass_rows_none>;
   rows_type rows;
   rows.stats.resize(size_t(h));
+  if (params.profile) rows.timers.resize(size_t(h));
   if constexpr (Sampler::learns) rows.records.resize(size_t(h));
 
   int threads = params.threads > 0 ? params.threads : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -138,14 +144,20 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     progress.pass_spp = count;
     progress.rows_done = 0;
     auto t0 = clock_type::now();
-    if (!run_pass(in, sampler, done, done + count, pass_sum, rows, arena, progress)) {
+    bool complete = params.profile ? run_pass<true>(in, sampler, done, done + count, pass_sum, rows, arena, progress)
+                                   : run_pass<false>(in, sampler, done, done + count, pass_sum, rows, arena, progress);
+    if (!complete) {
       result.interrupted = true;
       break;
     }
     for (size_t i = 0; i < n; i++) result.film[i] += pass_sum[i];
     for (const path_stats& st : rows.stats) add_stats(result.stats, st);
+    for (const cycle_timers& t : rows.timers)
+      for (int c = 0; c < prof_count; c++) result.profile_cycles[c] += t.cycles[c];
+    auto tl = clock_type::now();
     if constexpr (Sampler::learns) sampler.learn(rows.records);
     else sampler.end_pass();
+    result.learn_seconds += seconds_since(tl);
     result.seconds += seconds_since(t0);
     done += count;
     result.spp = done;

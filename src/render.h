@@ -10,6 +10,7 @@
 #include "integrator.h"
 #include "light_sampler.h"
 #include "metrics.h"
+#include "profile_timers.h"
 
 #include <cstdint>
 #include <functional>
@@ -31,6 +32,7 @@ struct render_params {
   sampler_params sampler;
   const image_data* reference = nullptr;  // error is measured after every pass when set
   bool progress = false;      // progress bar on stderr
+  bool profile = false;       // time the hot path's stages (profile_timers.h) into render_result::profile_cycles
   int frames = 1;             // animation frames (the sun moves from sun.direction to sun.direction_end)
   double frame_decay = 0.5;   // learned statistics are scaled by this at the start of every frame after the first
   std::vector<const image_data*> frame_references;  // per frame (overrides `reference` when not empty)
@@ -60,6 +62,8 @@ struct render_result {
   double seconds = 0;         // render wall time (passes and learning, not error computation)
   double setup_seconds = 0;   // light tree, regions (before the first pass; not in `seconds`)
   size_t sampler_bytes = 0;   // memory of the sampler's regions, cuts and statistics
+  double learn_seconds = 0;   // of `seconds`: learning between passes (the reduction and PMF rebuild)
+  uint64_t profile_cycles[prof_count] = {};  // time-stamp counter cycles per stage (profile renders only)
   int regions = 0;            // regions of a region-based sampler
   int64_t pairs = 0;          // (region, cluster) pairs
   path_stats stats;

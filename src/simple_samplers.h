@@ -11,6 +11,7 @@ struct uniform_sampler {
   static constexpr bool learns = false;
   struct context {};
   int count = 0;
+  void locate(context&, const shade_point&) const {}
   void prepare(context&, const shade_point&) const {}
   light_choice sample(const context&, double u, double) const {
     if (count == 0) return {};
@@ -27,6 +28,7 @@ struct power_sampler {
   static constexpr bool learns = false;
   struct context {};
   discrete_data dist;
+  void locate(context&, const shade_point&) const {}
   void prepare(context&, const shade_point&) const {}
   light_choice sample(const context&, double u, double) const {
     int i = sample_discrete(dist, u);

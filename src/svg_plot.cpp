@@ -155,8 +155,9 @@ std::string loglog_plot_svg(const std::vector<plot_series>& series, const loglog
        xml_escape(params.title) + "</text>\n";
   s += "<text x=\"" + num((f.left + f.right) / 2) + "\" y=\"" + num(h - 16) +
        "\" font-size=\"13\" text-anchor=\"middle\">" + xml_escape(params.x_label) + "</text>\n";
-  s += "<text x=\"20\" y=\"" + num((f.top + f.bottom) / 2) + "\" font-size=\"13\" text-anchor=\"middle\" transform=\"rotate(-90 20 " +
-       num((f.top + f.bottom) / 2) + ")\">" + xml_escape(params.y_label) + "</text>\n";
+  std::string mid = num((f.top + f.bottom) / 2);
+  s += "<text x=\"20\" y=\"" + mid + "\" font-size=\"13\" text-anchor=\"middle\" transform=\"rotate(-90 20 " + mid +
+       ")\">" + xml_escape(params.y_label) + "</text>\n";
   s += "</g>\n";
 
   // Curves and the guide, clipped to the plot area.

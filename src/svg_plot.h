@@ -21,8 +21,8 @@ struct loglog_plot_params {
   std::string title;
   std::string x_label = "x", y_label = "y";
   int width = 760, height = 480;
-  double guide_slope = -1;                   // a dashed guide line of this slope (0: none) ...
-  std::string guide_label = "slope \xe2\x88\x92" "1";  // ... through the first point of the first series
+  double guide_slope = -1;                          // a dashed guide line of this slope (0: none) through
+  std::string guide_label = "slope \u2212" "1";      // the first point of the first series, and its legend
 };
 
 // The SVG document of the plot: decade grid and tick labels, axis labels, one coloured path per series in a

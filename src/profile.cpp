@@ -1,0 +1,164 @@
+// profile: the two renders, the time-stamp counter calibration, the raw occlusion benchmark and the table.
+#include "profile.h"
+
+#include "camera.h"
+#include "rng.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+namespace bl {
+
+namespace {
+
+using clock_type = std::chrono::steady_clock;
+
+// Time-stamp counter ticks per second (measured against the steady clock over ~50 ms).
+double tsc_hz() {
+  auto t0 = clock_type::now();
+  uint64_t c0 = __rdtsc();
+  while (std::chrono::duration<double>(clock_type::now() - t0).count() < 0.05) {
+  }
+  double dt = std::chrono::duration<double>(clock_type::now() - t0).count();
+  return double(__rdtsc() - c0) / dt;
+}
+
+// Shadow rays distributed like the renderer's: from camera first hits to points sampled on uniformly chosen
+// lights (each moved off its surface as integrator.h's unoccluded() does).
+struct ray_set {
+  std::vector<vec3f> org, dir;
+  std::vector<float> tmax;
+};
+
+ray_set make_shadow_rays(const scene_data& scene, const bvh_data& bvh, const light_data& lights, int width,
+                         int height, size_t count) {
+  ray_set rays;
+  if (lights.count == 0) return rays;
+  camera_data cam = make_camera(scene.camera, width, height);
+  for (uint64_t s = 0; rays.org.size() < count && s < 64; s++)
+    for (int y = 0; y < height && rays.org.size() < count; y++)
+      for (int x = 0; x < width && rays.org.size() < count; x++) {
+        uint64_t key = sample_key(0x70726f66ull, uint64_t(y) * uint64_t(width) + uint64_t(x), s);
+        vertex_randoms c = draw_vertex(key, 0), v = draw_vertex(key, 1);
+        vec3f d = camera_ray_dir(cam, float(x) + c.u[0], float(y) + c.u[1]);
+        hit_info h = intersect(bvh, cam.eye, d);
+        if (h.tri == invalid_id) continue;
+        surface_point sp = eval_surface(scene, h.tri, h.b1, h.b2, d);
+        int light = std::min(int(v.u[0] * float(lights.count)), lights.count - 1);
+        light_sample ls = sample_light_point(lights, scene, light, sp.p, v.u[2], v.u[3]);
+        if (!(ls.pdf > 0)) continue;
+        vec3f o = offset_ray_origin(scene, sp.p, sp.ng, ls.wi);
+        if (ls.dist == inf_f) {
+          rays.org.push_back(o), rays.dir.push_back(ls.wi), rays.tmax.push_back(inf_f);
+          continue;
+        }
+        vec3f t = offset_ray_origin(scene, ls.p, ls.n, -ls.wi);
+        vec3f dd = t - o;
+        float len = length(dd);
+        if (!(len > 0)) continue;
+        rays.org.push_back(o), rays.dir.push_back(dd / len), rays.tmax.push_back(len);
+      }
+  return rays;
+}
+
+// Rays per second of rtcOccluded1 over the set on `threads` threads (best of three rounds).
+double occlusion_rate(const bvh_data& bvh, const ray_set& rays, int threads) {
+  if (rays.org.empty()) return 0;
+  tbb::task_arena arena(threads);
+  double best = 0;
+  for (int round = 0; round < 3; round++) {
+    auto t0 = clock_type::now();
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.org.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        int blocked = 0;
+        for (size_t i = r.begin(); i < r.end(); i++) blocked += occluded(bvh, rays.org[i], rays.dir[i], rays.tmax[i]);
+        volatile int sink = blocked;
+        (void)sink;
+      });
+    });
+    double dt = std::chrono::duration<double>(clock_type::now() - t0).count();
+    best = std::max(best, double(rays.org.size()) / dt);
+  }
+  return best;
+}
+
+const char* stage_name(int c) {
+  switch (c) {
+    case prof_camera: return "camera rays (generation + closest hit)";
+    case prof_bounce: return "closest hit of bounce rays";
+    case prof_shading: return "shading set-up (surface, BSDF, emission)";
+    case prof_region: return "region lookup";
+    case prof_pmf: return "PMF build at the point";
+    case prof_select: return "cluster / light choice";
+    case prof_point: return "point on the light + BSDF eval";
+    case prof_shadow: return "shadow rays";
+    case prof_record: return "observation recording";
+    case prof_continue: return "BSDF sampling + roulette";
+  }
+  return "?";
+}
+
+}  // namespace
+
+std::string profile_render(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
+                           const render_params& params, const std::string& title) {
+  int threads = params.threads > 0 ? params.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  render_params plain = params;
+  plain.profile = false;
+  plain.progress = false;
+  render_result a = render(scene, bvh, lights, plain);
+  render_params timed = plain;
+  timed.profile = true;
+  render_result b = render(scene, bvh, lights, timed);
+  double hz = tsc_hz();
+  const path_stats& st = a.stats;
+  double nee = double(std::max<uint64_t>(st.nee_samples, 1));
+  ray_set rays = make_shadow_rays(scene, bvh, lights, params.width, params.height,
+                                  std::min<size_t>(std::max<uint64_t>(st.shadow_rays, 1), size_t(4) << 20));
+  double limit = occlusion_rate(bvh, rays, threads);
+
+  std::string out;
+  char buf[512];
+  auto line = [&](const char* fmt, auto... args) {
+    std::snprintf(buf, sizeof buf, fmt, args...);
+    out += buf;
+  };
+  line("profile of %s\n", title.c_str());
+  line("  %dx%d, %d spp, max depth %d, %d threads\n", params.width, params.height, a.spp, params.max_depth, threads);
+  double rays_total = double(st.camera_rays + st.shadow_rays + st.bounce_rays);
+  line("  plain render: %.3f s in %d passes; %.3f M NEE samples (%.2f M/s); %.2f M rays/s (camera %.2f M, shadow "
+       "%.2f M, bounce %.2f M)\n",
+       a.seconds, a.passes, nee * 1e-6, nee / a.seconds * 1e-6, rays_total / a.seconds * 1e-6,
+       double(st.camera_rays) * 1e-6, double(st.shadow_rays) * 1e-6, double(st.bounce_rays) * 1e-6);
+  // Stage times are per-thread cycles; in wall time per NEE sample they are divided by the thread count.
+  double pass_wall = b.seconds - b.learn_seconds;
+  double staged = 0;
+  for (int c = 0; c < prof_count; c++) staged += double(b.profile_cycles[c]) / hz / threads;
+  line("\n  %-44s %10s %8s\n", "stage (timed render)", "ns/NEE", "share");
+  for (int c = 0; c < prof_count; c++) {
+    double wall = double(b.profile_cycles[c]) / hz / threads;
+    line("  %-44s %10.1f %7.1f%%\n", stage_name(c), wall / nee * 1e9, 100 * wall / b.seconds);
+  }
+  double rest = std::max(0.0, pass_wall - staged);
+  line("  %-44s %10.1f %7.1f%%\n", "film, scheduling and timer overhead", rest / nee * 1e9, 100 * rest / b.seconds);
+  line("  %-44s %10.1f %7.1f%%\n", "between passes: reduction + PMF rebuild", b.learn_seconds / nee * 1e9,
+       100 * b.learn_seconds / b.seconds);
+  line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee * 1e9, 100.0);
+  line("\n  raw Embree rtcOccluded1 on this scene: %.2f M rays/s (%zu rays, %d threads)\n", limit * 1e-6,
+       rays.org.size(), threads);
+  if (limit > 0)
+    line("  render NEE samples/s as a fraction of the raw shadow-ray limit: %.3f\n", nee / a.seconds / limit);
+  line("  between-pass learning: %.2f%% of the plain render's time\n", 100 * a.learn_seconds / std::max(a.seconds, 1e-9));
+  line("  timers cost: the timed render took %.1f%% longer than the plain one\n", 100 * (b.seconds / a.seconds - 1));
+  if (a.regions > 0)
+    line("  sampler state: %.2f MB; %d regions, %lld (region, cluster) pairs, %.1f bytes per pair\n",
+         double(a.sampler_bytes) / (1 << 20), a.regions, (long long)a.pairs,
+         a.pairs > 0 ? double(a.sampler_bytes) / double(a.pairs) : 0.0);
+  return out;
+}
+
+}  // namespace bl

@@ -1,0 +1,428 @@
+// Tests of `bayeslight compare` (SPEC.md section 4): its outputs on a tiny scene (curves.csv rows for every
+// pass, summary.md numbers equal to the CSV's last rows, a well-formed SVG with one path per sampler, images),
+// its exit statuses, and the pieces it is built from (time to a target error, the plot writer, the ramp).
+#include "compare.h"
+#include "error_image.h"
+#include "image_io.h"
+#include "svg_plot.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <map>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+// A tiny scene (a floor under a small lamp, 16x12 pixels, depth 2) and a 16 spp uniform reference of it.
+struct compare_scene {
+  temp_dir dir;
+  std::string json, ref;
+  compare_scene() {
+    write_text(dir / "box.obj",
+               "mtllib box.mtl\n"
+               "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
+               "v -0.2 1 -0.2\nv 0.2 1 -0.2\nv 0.2 1 0.2\nv -0.2 1 0.2\n"
+               "v 0.5 0.8 -0.2\nv 0.7 0.8 -0.2\nv 0.7 0.8 0.2\nv 0.5 0.8 0.2\n"
+               "usemtl floor\nf 1 4 3 2\n"
+               "usemtl lamp\nf 5 6 7 8\n"
+               "usemtl dim\nf 9 10 11 12\n");
+    write_text(dir / "box.mtl",
+               "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\nnewmtl dim\nKd 0 0 0\nKe 0.5 0.2 0.1\n");
+    json = dir / "scene.json";
+    write_text(json, "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], \"target\": [0, 0, 0]},"
+                     " \"image\": {\"width\": 16, \"height\": 12}, \"render\": {\"spp\": 2, \"max_depth\": 2}}");
+    ref = dir / "ref.exr";
+    run_result r = run_bayeslight("render " + json + " --sampler uniform --spp 16 --seed 99 -o " + ref + " --quiet");
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+  }
+};
+
+// One row of curves.csv.
+struct csv_row {
+  std::string sampler;
+  int run = 0, pass = 0, spp = 0;
+  unsigned long long seed = 0;
+  double seconds = 0, relmse = 0, mse = 0;
+};
+
+// The rows of curves.csv (the header is checked).
+std::vector<csv_row> read_curves(const std::string& path) {
+  std::ifstream f(path);
+  std::string line;
+  std::getline(f, line);
+  CHECK(line == "sampler,run,seed,pass,spp,seconds,relmse,mse");
+  std::vector<csv_row> rows;
+  while (std::getline(f, line)) {
+    std::vector<std::string> c;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) c.push_back(cell);
+    REQUIRE(c.size() == 8);
+    rows.push_back({c[0], std::stoi(c[1]), std::stoi(c[3]), std::stoi(c[4]), std::stoull(c[2]), std::stod(c[5]),
+                    std::stod(c[6]), std::stod(c[7])});
+  }
+  return rows;
+}
+
+// Cells of the data rows of summary.md's table, by sampler (cells trimmed; the sampler cell is the key).
+std::map<std::string, std::vector<std::string>> read_summary_table(const std::string& text) {
+  std::map<std::string, std::vector<std::string>> table;
+  std::stringstream ss(text);
+  std::string line;
+  while (std::getline(ss, line)) {
+    if (line.rfind("| ", 0) != 0 || line.rfind("| sampler ", 0) == 0) continue;
+    std::vector<std::string> cells;
+    size_t pos = 1;
+    while (pos < line.size()) {
+      size_t bar = line.find('|', pos);
+      if (bar == std::string::npos) break;
+      std::string cell = line.substr(pos, bar - pos);
+      cell.erase(0, cell.find_first_not_of(' '));
+      cell.erase(cell.find_last_not_of(' ') + 1);
+      cells.push_back(cell);
+      pos = bar + 1;
+    }
+    REQUIRE(cells.size() == 7);
+    table[cells[0]] = cells;
+  }
+  return table;
+}
+
+// Whole content of a file.
+std::string slurp(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// Occurrences of `needle` in `text`.
+int count_of(const std::string& text, const std::string& needle) {
+  int n = 0;
+  for (size_t p = text.find(needle); p != std::string::npos; p = text.find(needle, p + 1)) n++;
+  return n;
+}
+
+// Minimal XML well-formedness: one root element, balanced and matching tags, quoted attributes without '<',
+// entity references among the predefined ones or numeric; declarations, comments and CDATA are skipped.
+// Returns "" when well-formed, else what is wrong.
+std::string xml_problem(const std::string& s) {
+  std::vector<std::string> open;
+  int roots = 0;
+  auto name_char = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == ':' || c == '.';
+  };
+  auto check_entities = [](const std::string& t) -> bool {
+    for (size_t p = t.find('&'); p != std::string::npos; p = t.find('&', p + 1)) {
+      size_t semi = t.find(';', p);
+      if (semi == std::string::npos) return false;
+      std::string e = t.substr(p + 1, semi - p - 1);
+      bool named = e == "amp" || e == "lt" || e == "gt" || e == "quot" || e == "apos";
+      if (!named && (e.empty() || e[0] != '#')) return false;
+    }
+    return true;
+  };
+  size_t i = 0;
+  while (i < s.size()) {
+    if (s[i] != '<') {
+      size_t next = s.find('<', i);
+      std::string text = s.substr(i, next == std::string::npos ? std::string::npos : next - i);
+      if (open.empty() && text.find_first_not_of(" \t\r\n") != std::string::npos) return "text outside the root";
+      if (!check_entities(text)) return "bad entity in text";
+      if (next == std::string::npos) break;
+      i = next;
+      continue;
+    }
+    if (s.compare(i, 4, "<!--") == 0) {
+      size_t e = s.find("-->", i);
+      if (e == std::string::npos) return "unterminated comment";
+      i = e + 3;
+      continue;
+    }
+    if (s.compare(i, 2, "<?") == 0) {
+      size_t e = s.find("?>", i);
+      if (e == std::string::npos) return "unterminated declaration";
+      i = e + 2;
+      continue;
+    }
+    if (s.compare(i, 9, "<![CDATA[") == 0) {
+      size_t e = s.find("]]>", i);
+      if (e == std::string::npos) return "unterminated CDATA";
+      i = e + 3;
+      continue;
+    }
+    bool closing = s.compare(i, 2, "</") == 0;
+    size_t p = i + (closing ? 2 : 1), start = p;
+    while (p < s.size() && name_char(s[p])) p++;
+    std::string name = s.substr(start, p - start);
+    if (name.empty()) return "tag without a name at " + std::to_string(i);
+    if (closing) {
+      while (p < s.size() && std::isspace(static_cast<unsigned char>(s[p]))) p++;
+      if (p >= s.size() || s[p] != '>') return "bad end tag " + name;
+      if (open.empty() || open.back() != name) return "end tag " + name + " does not match";
+      open.pop_back();
+      i = p + 1;
+      continue;
+    }
+    // Attributes: name="value" or name='value'.
+    for (;;) {
+      while (p < s.size() && std::isspace(static_cast<unsigned char>(s[p]))) p++;
+      if (p >= s.size()) return "unterminated tag " + name;
+      if (s[p] == '>' || s.compare(p, 2, "/>") == 0) break;
+      size_t a = p;
+      while (p < s.size() && name_char(s[p])) p++;
+      if (p == a) return "bad attribute in " + name;
+      while (p < s.size() && std::isspace(static_cast<unsigned char>(s[p]))) p++;
+      if (p >= s.size() || s[p] != '=') return "attribute without value in " + name;
+      p++;
+      while (p < s.size() && std::isspace(static_cast<unsigned char>(s[p]))) p++;
+      if (p >= s.size() || (s[p] != '"' && s[p] != '\'')) return "unquoted attribute in " + name;
+      char q = s[p];
+      size_t e = s.find(q, p + 1);
+      if (e == std::string::npos) return "unterminated attribute in " + name;
+      std::string value = s.substr(p + 1, e - p - 1);
+      if (value.find('<') != std::string::npos || !check_entities(value)) return "bad attribute value in " + name;
+      p = e + 1;
+    }
+    if (open.empty()) roots++;
+    if (roots > 1) return "more than one root element";
+    if (s[p] == '>') {
+      open.push_back(name);
+      i = p + 1;
+    } else {
+      i = p + 2;
+    }
+  }
+  if (!open.empty()) return "unclosed element " + open.back();
+  if (roots != 1) return "no root element";
+  return "";
+}
+
+// Whether xmllint is on this machine.
+bool have_xmllint() { return std::system("command -v xmllint >/dev/null 2>&1") == 0; }
+
+// Checks everything a comparison wrote into out: files, CSV rows per sampler and run, summary = CSV's last rows.
+void check_outputs(const std::string& out, const std::vector<std::string>& samplers, int runs, bool equal_time) {
+  for (const char* name : {"curves.csv", "error_vs_time.svg", "summary.md"})
+    CHECK(std::filesystem::exists(out + "/" + std::string(name)));
+  std::vector<csv_row> rows = read_curves(out + "/curves.csv");
+  std::string summary = slurp(out + "/summary.md");
+  INFO(summary);
+  auto table = read_summary_table(summary);
+  REQUIRE(table.size() == samplers.size());
+  double base_relmse = 0;
+  for (size_t k = 0; k < samplers.size(); k++) {
+    const std::string& s = samplers[k];
+    // Rows of every run, passes numbered 1, 2, ... with growing spp and time.
+    std::vector<const csv_row*> last;
+    for (int run = 1; run <= runs; run++) {
+      const csv_row* prev = nullptr;
+      for (const csv_row& r : rows) {
+        if (r.sampler != s || r.run != run) continue;
+        CHECK(r.pass == (prev ? prev->pass + 1 : 1));
+        if (prev) CHECK(r.spp > prev->spp);
+        if (prev) CHECK(r.seconds >= prev->seconds);
+        CHECK(r.relmse > 0);
+        CHECK(r.mse > 0);
+        prev = &r;
+      }
+      REQUIRE(prev != nullptr);
+      last.push_back(prev);
+    }
+    // The summary's numbers are those of the runs' last rows (means over runs).
+    const std::vector<std::string>& cells = table.at(s);
+    double relmse = 0, seconds = 0;
+    for (const csv_row* r : last) relmse += r->relmse / runs, seconds += r->seconds / runs;
+    CHECK(std::stoi(cells[1]) == last[0]->spp);
+    CHECK(std::stod(cells[2]) == Approx(seconds).epsilon(1e-3).margin(2e-6));
+    CHECK(std::stod(cells[3]) == Approx(relmse).epsilon(2e-4));
+    if (runs > 1) {
+      double var = 0;
+      for (const csv_row* r : last) var += (r->relmse - relmse) * (r->relmse - relmse) / (runs - 1);
+      size_t pm = cells[3].find("\xc2\xb1");
+      REQUIRE(pm != std::string::npos);
+      CHECK(std::stod(cells[3].substr(pm + 2)) == Approx(std::sqrt(var)).epsilon(1e-2));
+    }
+    // Time to the first sampler's final relMSE: the first sampler reaches it by its last pass at the latest.
+    if (cells[5] != "\xe2\x80\x94") {
+      CHECK(std::stod(cells[5]) > 0);
+      CHECK(std::stod(cells[5]) <= seconds * 1.001 + 2e-6);
+    }
+    if (k == 0) {
+      base_relmse = relmse;
+      CHECK(cells[4] == "1.00");
+      CHECK(cells[5] != "\xe2\x80\x94");
+    } else if (equal_time) {
+      CHECK(std::stod(cells[4]) == Approx(base_relmse / relmse).epsilon(1e-2));
+    }
+    // The render and its false-colour error image.
+    image_data img = read_image(out + "/" + s + ".exr");
+    CHECK(img.width == 16);
+    CHECK(img.height == 12);
+    std::string png = slurp(out + "/" + s + "_error.png");
+    CHECK(png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0);
+  }
+  // The plot: well-formed XML, one path per sampler, the dashed guide, every sampler in the legend.
+  std::string svg = slurp(out + "/error_vs_time.svg");
+  CHECK(xml_problem(svg) == "");
+  CHECK(count_of(svg, "<path") + count_of(svg, "<polyline") == int(samplers.size()));
+  CHECK(count_of(svg, "stroke-dasharray") >= 1);
+  for (const std::string& s : samplers) CHECK(svg.find(">" + s + "</text>") != std::string::npos);
+  if (have_xmllint()) CHECK(std::system(("xmllint --noout " + out + "/error_vs_time.svg").c_str()) == 0);
+}
+
+}  // namespace
+
+TEST_CASE("compare at equal spp writes curves summary plot and images", "[compare]") {
+  compare_scene s;
+  std::string out = s.dir / "out";  // does not exist yet: compare creates it
+  run_result r = run_bayeslight("compare " + s.json + " --reference " + s.ref +
+                                " --spp 4 --samplers uniform,power,bvh --out " + out + " --threads 2 --quiet");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  check_outputs(out, {"uniform", "power", "bvh"}, 1, false);
+  std::vector<csv_row> rows = read_curves(out + "/curves.csv");
+  CHECK(rows.size() == 12);  // 4 passes of 1 spp for each sampler
+  for (const csv_row& row : rows) CHECK(row.seed == 0);  // the scene's seed
+  std::string summary = slurp(out + "/summary.md");
+  CHECK(summary.find("reference: " + s.ref) != std::string::npos);
+  CHECK(summary.find("Equal samples: 4 spp") != std::string::npos);
+  // No temporary files left behind.
+  for (auto& e : std::filesystem::directory_iterator(out))
+    CHECK(e.path().filename().string().find(".tmp") == std::string::npos);
+}
+
+TEST_CASE("compare repeats runs with consecutive seeds and reports mean and deviation", "[compare]") {
+  compare_scene s;
+  std::string out = s.dir / "out";
+  run_result r = run_bayeslight("compare " + s.json + " --reference " + s.ref +
+                                " --spp 3 --runs 3 --seed 7 --samplers power,bayes --out " + out +
+                                " --reference-note 'reference: 16 spp uniform, seed 99' --quiet");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  check_outputs(out, {"power", "bayes"}, 3, false);
+  std::vector<csv_row> rows = read_curves(out + "/curves.csv");
+  CHECK(rows.size() == 2 * 3 * 3);
+  for (const csv_row& row : rows) CHECK(row.seed == 7 + unsigned(row.run) - 1);
+  std::string summary = slurp(out + "/summary.md");
+  CHECK(summary.find("reference: 16 spp uniform, seed 99") != std::string::npos);
+  // A run's image equals a plain render with the same seed and spp (compare renders exactly like render).
+  REQUIRE(run_bayeslight("render " + s.json + " --sampler bayes --spp 3 --seed 7 -o " + (s.dir / "b.exr") + " --quiet")
+              .status == 0);
+  CHECK(bit_identical(read_image(out + "/bayes.exr"), read_image(s.dir / "b.exr")));
+}
+
+TEST_CASE("compare at equal time gives every sampler the same budget", "[compare]") {
+  compare_scene s;
+  std::string out = s.dir / "out";
+  run_result r = run_bayeslight("compare " + s.json + " --reference " + s.ref +
+                                " --time 0.05 --samplers bound,uniform --out " + out + " --quiet");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  check_outputs(out, {"bound", "uniform"}, 1, true);
+  for (const csv_row& row : read_curves(out + "/curves.csv")) CHECK(row.seconds > 0);
+  std::map<std::string, double> final_seconds;
+  for (const csv_row& row : read_curves(out + "/curves.csv")) final_seconds[row.sampler] = row.seconds;
+  CHECK(final_seconds["bound"] >= 0.05);
+  CHECK(final_seconds["uniform"] >= 0.05);
+  CHECK(slurp(out + "/summary.md").find("Equal time: 0.05 s") != std::string::npos);
+}
+
+TEST_CASE("bad compare invocations exit 2 or 3 and write nothing", "[compare]") {
+  compare_scene s;
+  std::string out = s.dir / "out";
+  std::string base = "compare " + s.json + " --out " + out + " --quiet ";
+  struct bad_case {
+    std::string args;
+    int status;
+    std::string expect;
+  };
+  REQUIRE(run_bayeslight("render " + s.json + " --spp 1 --width 8 --height 6 -o " + (s.dir / "small.exr") + " --quiet")
+              .status == 0);
+  std::vector<bad_case> cases = {
+      {base + "--reference " + s.ref + " --spp 2 --samplers uniform,nosuch", 2, "uniform | power"},
+      {base + "--spp 2 --samplers uniform", 2, "--reference"},
+      {base + "--reference " + s.ref + " --spp 2 --time 1 --samplers uniform", 2, "--time"},
+      {base + "--reference " + s.ref + " --samplers uniform", 2, "--time and --spp"},
+      {base + "--reference " + s.ref + " --spp 2", 2, "--samplers"},
+      {base + "--reference " + s.ref + " --spp 2 --samplers uniform,uniform", 2, "twice"},
+      {base + "--reference " + s.ref + " --spp 2 --samplers uniform --runs 0", 2, "--runs"},
+      {base + "--reference " + s.ref + " --spp 2 --samplers uniform --frames 2", 2, "--frames"},
+      {"compare " + s.json + " --reference " + s.ref + " --spp 2 --samplers uniform", 2, "--out"},
+      {base + "--reference " + (s.dir / "small.exr") + " --spp 2 --samplers uniform", 3, "8x6"},
+      {base + "--reference " + (s.dir / "missing.exr") + " --spp 2 --samplers uniform", 3, "missing.exr"},
+      {"compare " + (s.dir / "nosuch.json") + " --out " + out + " --reference " + s.ref + " --spp 2 --samplers uniform",
+       3, "nosuch.json"},
+  };
+  for (const bad_case& c : cases) {
+    run_result r = run_bayeslight(c.args);
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.status == c.status);
+    CHECK(r.output.find(c.expect) != std::string::npos);
+    CHECK(!std::filesystem::exists(out));
+  }
+}
+
+TEST_CASE("time to reach a target error interpolates log-log between passes", "[compare]") {
+  // relMSE = 1 / t exactly: the log-log interpolation recovers t = 1 / target between any two passes.
+  std::vector<double> t = {1, 2, 4, 8}, e = {1, 0.5, 0.25, 0.125};
+  CHECK(time_to_reach(t, e, 0.3) == Approx(1 / 0.3).epsilon(1e-12));
+  CHECK(time_to_reach(t, e, 0.125) == Approx(8).epsilon(1e-12));
+  CHECK(time_to_reach(t, e, 2.0) == 1);       // already reached by the first pass
+  CHECK(time_to_reach(t, e, 0.1) == -1);      // never reached
+  CHECK(time_to_reach({}, {}, 0.1) == -1);
+  // A dip below the target that rises again does not count: the curve must stay at or below it.
+  CHECK(time_to_reach({1, 2, 4}, {1, 0.2, 0.6}, 0.5) == -1);
+  CHECK(time_to_reach({1, 2, 4, 8}, {1, 0.2, 0.6, 0.3}, 0.5) == Approx(std::exp(std::log(4.0) + std::log(5.0 / 6.0) *
+                                                                                   std::log(2.0) / std::log(0.5))));
+}
+
+TEST_CASE("the plot writer escapes labels and draws one path per series", "[compare]") {
+  plot_series a{"a<b>&\"c\"", {0.01, 0.1, 1}, {1, 0.1, 0.01}};
+  plot_series b{"second", {0.0, -1, 0.5, 2}, {1, 1, 0.2, NAN}};  // only (0.5, 0.2) can be placed on log axes
+  loglog_plot_params p;
+  p.title = "t & t";
+  std::string svg = loglog_plot_svg({a, b}, p);
+  CHECK(xml_problem(svg) == "");
+  CHECK(count_of(svg, "<path") == 2);
+  CHECK(svg.find("a&lt;b&gt;&amp;&quot;c&quot;") != std::string::npos);
+  CHECK(svg.find("stroke-dasharray") != std::string::npos);
+  CHECK(plot_color(0) != plot_color(1));
+  CHECK(plot_color(12) != plot_color(13));
+  CHECK(plot_color(12).size() == 7);
+  // Nothing plottable still gives a valid document (axes, legend, no paths).
+  std::string empty = loglog_plot_svg({plot_series{"none", {}, {}}}, p);
+  CHECK(xml_problem(empty) == "");
+  CHECK(count_of(empty, "<path") == 0);
+  // The checker itself rejects malformed documents.
+  CHECK(xml_problem("<svg><g></svg>") != "");
+  CHECK(xml_problem("<svg a=1></svg>") != "");
+  CHECK(xml_problem("<svg>a & b</svg>") != "");
+}
+
+TEST_CASE("the error ramp spans viridis over a fixed logarithmic range", "[compare]") {
+  std::array<uint8_t, 3> lo = viridis_srgb8(0), hi = viridis_srgb8(1), nan = viridis_srgb8(NAN);
+  CHECK((lo == std::array<uint8_t, 3>{0x44, 0x01, 0x54}));
+  CHECK((hi == std::array<uint8_t, 3>{0xfd, 0xe7, 0x25}));
+  CHECK(nan == hi);
+  CHECK(viridis_srgb8(-1) == lo);
+  CHECK(viridis_srgb8(7) == hi);
+  image_data x, r;
+  x.width = r.width = 2;
+  x.height = r.height = 1;
+  r.pixels = {1, 1, 1, 0, 0, 0};
+  x.pixels = {1.5f, 1.5f, 1.5f, 0.05f, 0, 0.1f};
+  std::vector<float> err = relative_error_map(x, r);
+  REQUIRE(err.size() == 2);
+  CHECK(err[0] == Approx(0.5 / 1.1));
+  CHECK(err[1] == Approx((0.5 + 0 + 1.0) / 3));
+  std::string png = encode_error_png(x, r, error_image_params{});
+  CHECK(png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0);
+}
