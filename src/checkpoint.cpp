@@ -194,7 +194,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(p.width), h.value(p.height), h.value(p.max_depth), h.value(p.seed), h.value(int(p.sampler.kind));
   const region_params& r = p.sampler.regions;
   h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
-  h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs);
+  h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
   const bayes_params& b = p.sampler.bayes;
   h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);

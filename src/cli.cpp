@@ -255,6 +255,9 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--cut-coherence", o.regions.coherence,
                 "Keep a light cluster whole when its radius / gap to the region <= this (default 0.25; 0 = off)")
       ->check(CLI::Range(0.0, 100.0))->group(grp);
+  r->add_option("--fine-depth", o.regions.fine_depth,
+                "Path vertices up to this depth use fine regions, deeper ones coarse regions (default 1)")
+      ->check(CLI::Range(1, 1000))->group(grp);
   r->add_option("--region-min-samples", o.regions.min_samples,
                 "NEE samples a fine cell asks for before it gets its own region (default 16)")
       ->check(CLI::Range(1, 1 << 30))->group(grp);

@@ -12,10 +12,15 @@ void locate_region(cut_context& ctx, const region_state& regions, const shade_po
   ctx.n = sp.n;
   ctx.albedo = sp.albedo;
   uint64_t key = fine_region_key(regions.grid, sp.p);
+  // Deep path vertices are few per cell and scattered: they use (and pool their samples in) coarse regions,
+  // whose small table stays in cache.
+  bool coarse = sp.depth > regions.params.fine_depth;
+  if (coarse) key = parent_region_key(regions.grid, key, 1);
   // Neighbouring samples often fall in the same cell: reuse the last lookup (regions are frozen during a pass).
   if (key != ctx.fine_key) {
     ctx.fine_key = key;
-    ctx.region = find_region(regions, key);
+    int r = find_region_key(regions, key);
+    ctx.region = r != invalid_id ? r : (coarse ? regions.root : find_region(regions, key));
   }
   ctx.count = regions.cut_size[size_t(ctx.region)];
   ctx.nodes = regions.cut_nodes.data() + regions.cut_offset[size_t(ctx.region)];

@@ -23,7 +23,7 @@ struct cut_context {
   vec3f p, n;
   float albedo = 0;
   int pixel = invalid_id;      // (samplers that learn per pixel)
-  uint64_t fine_key = ~uint64_t(0);  // (no fine key yet: see locate_region's reuse of the last lookup)
+  uint64_t fine_key = ~uint64_t(0);  // the cell key looked up (fine, or coarse for deep vertices); ~0: none yet
   int region = 0;
   int count = 0;               // clusters in the cut
   int tree_count = 0;          // of which tree nodes (the sun, if any, is last)

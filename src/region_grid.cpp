@@ -235,13 +235,15 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
   int64_t pairs = s.pairs;
   for (uint64_t key : fine_keys) {
     if (find_region_key(s, key) != invalid_id) continue;
-    uint64_t ckey = parent_region_key(s.grid, key, 1);
+    bool coarse_only = is_coarse_key(key);
+    uint64_t ckey = coarse_only ? key : parent_region_key(s.grid, key, 1);
     if (find_region_key(s, ckey) == invalid_id && std::find(new_coarse.begin(), new_coarse.end(), ckey) == new_coarse.end()) {
       // Coarse regions are at most 1/512 of the fine ones; they ignore the budget.
       new_coarse.push_back(ckey);
       todo.push_back({ckey, empty_region_key});
       pairs += per_region;
     }
+    if (coarse_only) continue;
     if (pairs + per_region > s.params.max_pairs) continue;  // over budget: the coarse region serves
     todo.push_back({key, ckey});
     pairs += per_region;

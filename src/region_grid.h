@@ -24,6 +24,7 @@ struct region_params {
                                    // normals lie within 30 degrees (its lights light the region alike)
   int shared_cut_lights = 4;       // at most this many lights: one cut of all lights, no clustering
   int min_samples = 16;            // NEE samples a fine cell must ask for before its region is created
+  int fine_depth = 1;              // path vertices up to this depth use fine regions, deeper ones coarse regions
   int64_t max_pairs = int64_t(1) << 20;  // memory budget in (region, cluster) pairs
 };
 
@@ -72,6 +73,8 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
 
 // Key of the fine cell containing p.
 uint64_t fine_region_key(const region_grid_data& g, vec3f p);
+// Whether a key is a coarse cell's.
+inline bool is_coarse_key(uint64_t key) { return (key >> 62) == 1; }
 // Key of the cell of `level` containing the fine cell `fine_key`.
 uint64_t parent_region_key(const region_grid_data& g, uint64_t fine_key, int level);
 // Box of the cell with this key.
@@ -86,8 +89,9 @@ bool add_pending(region_state& s, uint64_t key, uint32_t count);
 // Forgets the pending count of a key (its region is being created).
 void remove_pending(region_state& s, uint64_t key);
 
-// Creates regions for requested fine keys (sorted, deduplicated by the caller): each fine key's coarse parent
-// first, then the fine region while the pair budget allows. Returns the number of regions added.
+// Creates regions for requested keys (sorted, deduplicated by the caller): for a fine key its coarse parent
+// first, then the fine region while the pair budget allows; a coarse key creates only the coarse region.
+// Returns the number of regions added.
 int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys);
 
 // The light cut of a box: tree nodes sorted by id (then sun_cluster if has_sun), Lightcuts-style refinement of
