@@ -5,33 +5,45 @@
 #include <algorithm>
 #include <numeric>
 
+#include <tbb/parallel_invoke.h>
+
 namespace bl {
 
 namespace {
 
-// A normal cone (axis, half-angle theta) during the build; empty cones hold no direction yet.
+// A normal cone (axis, half-angle theta, with its cosine and sine) during the build; empty cones hold no
+// direction yet.
 struct cone_bound {
   vec3f axis = {0, 0, 1};
-  float theta = 0;
+  float theta = 0, cos_t = 1, sin_t = 0;
   bool empty = true;
 };
+cone_bound make_cone(vec3f axis, float theta) {
+  if (theta >= pi_f) return {axis, pi_f, -1, 0, false};
+  return {axis, theta, std::cos(theta), std::sin(theta), false};
+}
 
 // The smallest cone (Conty-Kulla's union) containing both cones.
 cone_bound cone_union(cone_bound a, cone_bound b) {
   if (a.empty) return b;
   if (b.empty) return a;
   if (b.theta > a.theta) std::swap(a, b);
-  float theta_d = safe_acos(dot(a.axis, b.axis));
+  if (a.theta >= pi_f) return a;
+  // Containment without inverse trigonometry (the common case while binning): the angle between the axes is at
+  // most theta_a - theta_b, i.e. its cosine is at least cos(theta_a - theta_b).
+  float cos_d = dot(a.axis, b.axis);
+  if (cos_d >= a.cos_t * b.cos_t + a.sin_t * b.sin_t) return a;
+  float theta_d = safe_acos(cos_d);
   if (std::min(theta_d + b.theta, pi_f) <= a.theta) return a;
   float theta = 0.5f * (a.theta + theta_d + b.theta);
-  if (theta >= pi_f) return {a.axis, pi_f, false};
+  if (theta >= pi_f) return make_cone(a.axis, pi_f);
   float theta_r = theta - a.theta;
   vec3f wr = cross(a.axis, b.axis);
-  if (!(length_sq(wr) > 0)) return {a.axis, pi_f, false};
+  if (!(length_sq(wr) > 0)) return make_cone(a.axis, pi_f);
   wr = normalize(wr);
   // Rotate a.axis by theta_r toward b.axis (a.axis is perpendicular to wr).
   vec3f axis = normalize(a.axis * std::cos(theta_r) + cross(wr, a.axis) * std::sin(theta_r));
-  return {axis, theta, false};
+  return make_cone(axis, theta);
 }
 
 // Bounds of a set of emitters during the build.
@@ -73,13 +85,13 @@ struct build_item {
 struct builder {
   light_tree_data& t;
   std::vector<build_item>& items;
-  int next = 0;
 
-  // Builds the subtree over items [b, e) and returns its node id (nodes are numbered in depth-first order).
-  int build(int b, int e, int parent, int depth) {
-    int node = next++;
+  // Builds the subtree over items [b, e) as node `node` (depth-first numbering: its left child is node + 1, its
+  // right child node + 2 (mid - b), since a subtree over k items has 2k - 1 nodes) and returns its depth. Large
+  // subtrees are built in parallel: ids are fixed in advance and each half touches only its own items and
+  // nodes, so the tree does not depend on the thread count.
+  int build(int b, int e, int node, int parent, int depth) {
     t.parent[size_t(node)] = parent;
-    t.depth = std::max(t.depth, depth);
     build_bounds bounds;
     bbox3f cbox;
     for (int i = b; i < e; i++) {
@@ -91,12 +103,21 @@ struct builder {
       int l = items[size_t(b)].light;
       t.light[size_t(node)] = l;
       t.leaf_of_light[size_t(l)] = node;
-      return node;
+      return depth;
     }
     int mid = split(b, e, bounds, cbox, depth);
-    t.left[size_t(node)] = build(b, mid, node, depth + 1);
-    t.right[size_t(node)] = build(mid, e, node, depth + 1);
-    return node;
+    int left = node + 1, right = node + 2 * (mid - b);
+    t.left[size_t(node)] = left;
+    t.right[size_t(node)] = right;
+    int dl = 0, dr = 0;
+    if (e - b > 4096) {
+      tbb::parallel_invoke([&] { dl = build(b, mid, left, node, depth + 1); },
+                           [&] { dr = build(mid, e, right, node, depth + 1); });
+    } else {
+      dl = build(b, mid, left, node, depth + 1);
+      dr = build(mid, e, right, node, depth + 1);
+    }
+    return std::max(dl, dr);
   }
 
   void store(int node, const build_bounds& bb) {
@@ -193,7 +214,7 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
     vec3f p1 = p0 + scene.tri_e1[size_t(tri)], p2 = p0 + scene.tri_e2[size_t(tri)];
     build_item& it = items[size_t(l)];
     it.bounds.box = merge(merge(merge(bbox3f{}, p0), p1), p2);
-    it.bounds.cone = {scene.tri_ng[size_t(tri)], lights.two_sided ? pi_f : 0.0f, false};
+    it.bounds.cone = make_cone(scene.tri_ng[size_t(tri)], lights.two_sided ? pi_f : 0.0f);
     it.bounds.intensity = luminance(lights.radiance[size_t(l)]) * scene.tri_area[size_t(tri)];
     it.centroid = center(it.bounds.box);
     it.light = l;
@@ -212,7 +233,7 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
   t.parent.assign(nodes, invalid_id);
   t.light.assign(nodes, invalid_id);
   builder bld{t, items};
-  bld.build(0, n, invalid_id, 0);
+  t.depth = bld.build(0, n, 0, invalid_id, 0);
   t.packed.resize(nodes);
   for (size_t i = 0; i < nodes; i++)
     t.packed[i] = {t.center[i].x, t.center[i].y, t.center[i].z, t.radius[i], t.axis[i].x, t.axis[i].y, t.axis[i].z,
