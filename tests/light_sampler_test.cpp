@@ -118,7 +118,9 @@ std::vector<shade_point> shading_points(const test_scene& t, int count, uint64_t
     if (h.tri == invalid_id) continue;
     surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, dir);
     const material_data& m = t.scene.mesh.materials[size_t(sp.material)];
-    out.push_back(shade_point{sp.p, sp.ng, luminance(m.kd) + luminance(m.ks), int(out.size()), 1 + tries % 2});
+    // Pixels cycle through the image (samplers that learn per pixel index their tables with them).
+    int pixel = int(out.size()) % (t.in.camera.width * t.in.camera.height);
+    out.push_back(shade_point{sp.p, sp.ng, luminance(m.kd) + luminance(m.ks), pixel, 1 + tries % 2});
   }
   return out;
 }
