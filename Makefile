@@ -5,6 +5,8 @@
 #   make bench    benchmarks (long renders, equal-time tables, microbenchmarks)
 #   make golden   regenerate golden/ (only for a deliberate change of output; say why in the commit)
 #   make clean    remove build outputs
+#   make fuzz           libFuzzer targets for every input parser (clang, build-fuzz/), FUZZ_SECONDS each (default 60)
+#   make test-sanitize  the whole test suite and small renders under ASan + UBSan (build-sanitize/)
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PKGS := g++ make cmake pkg-config python3 libembree-dev libtinyobjloader-dev libstb-dev libpcg-cpp-dev catch2 \
@@ -43,3 +45,27 @@ golden: build
 
 clean:
 	rm -rf $(BUILD)
+
+# ---- Robustness (issue 5): fuzzing and sanitizers, each in its own build folder. -----------------------------
+# make fuzz: installs clang + libFuzzer if missing, builds fuzz_{scene,obj,texture,image} (-DBAYESLIGHT_FUZZ=ON)
+# and fuzzes each for FUZZ_SECONDS; new crashes land in fuzz/crashes/<target>/ (see fuzz/README.md).
+FUZZ_SECONDS ?= 60
+FUZZ_BUILD ?= build-fuzz
+FUZZ_PKGS := clang libclang-rt-14-dev zlib1g-dev
+FUZZ_TARGETS := fuzz_scene fuzz_obj fuzz_texture fuzz_image fuzz_make_seeds
+SANITIZE_BUILD ?= build-sanitize
+
+.PHONY: fuzz fuzz-build test-sanitize
+
+fuzz-build: deps
+	@$(MAKE) --no-print-directory deps PKGS="$(FUZZ_PKGS)"
+	@cmake -S . -B $(FUZZ_BUILD) -DCMAKE_CXX_COMPILER=clang++ -DBAYESLIGHT_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target $(FUZZ_TARGETS)
+
+fuzz: fuzz-build
+	fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
+
+# make test-sanitize: builds with -DBAYESLIGHT_SANITIZE=ON (ASan + UBSan) and runs ctest plus small renders of every
+# data/ scene with every sampler; prints how long each step took.
+test-sanitize: deps
+	tools/sanitize.sh $(SANITIZE_BUILD) $(JOBS)

@@ -180,19 +180,56 @@ static float exr_sample(const unsigned char* p, int pixel_type, size_t i) {
   return reinterpret_cast<const float*>(p)[i];
 }
 
+// Zero bytes kept after the file's data in memory (not part of what tinyexr is told it got): tinyexr 1.0.1's PIZ
+// decoder reads its bitmap (up to 8 KiB) and a length past the end of a short chunk before checking the chunk's
+// size (DecompressPiz, tinyexr.h:3095-3116); with the padding those reads stay inside our buffer.
+static constexpr size_t exr_read_padding = 64 * 1024;
+
+// The value of the last non-empty "type" attribute of the EXR header at mem (after the 8-byte magic and version),
+// read as tinyexr's ParseEXRHeader reads it ("" when there is none or the header is malformed: tinyexr then fails
+// on its own). tinyexr 1.0.1 asserts on type values that disagree with the version flags (ConvertHeader,
+// tinyexr.h:4536-4548), and Debian builds it with assertions on: an unknown type aborts the process.
+static std::string exr_type_attribute(const unsigned char* mem, size_t size) {
+  std::string type;
+  size_t pos = 8;
+  while (pos < size && mem[pos] != 0) {
+    const char* p = reinterpret_cast<const char*>(mem + pos);
+    size_t left = size - pos;
+    size_t name_len = strnlen(p, left);
+    if (name_len == left) break;
+    size_t type_len = strnlen(p + name_len + 1, left - name_len - 1);
+    if (type_len == left - name_len - 1) break;
+    size_t head = name_len + 1 + type_len + 1;
+    if (left - head < 4) break;
+    uint32_t len = uint32_t(mem[pos + head]) | uint32_t(mem[pos + head + 1]) << 8 |
+                   uint32_t(mem[pos + head + 2]) << 16 | uint32_t(mem[pos + head + 3]) << 24;
+    if (left - head - 4 < len) break;
+    const char* data = p + head + 4;
+    if (std::strcmp(p, "type") == 0 && len > 0 && data[0] != 0) type.assign(data, strnlen(data, len));
+    for (char& c : type) c = c >= 32 && c < 127 ? c : '?';  // for the message
+    pos += head + 4 + len;
+  }
+  return type;
+}
+
 // Reads R, G, B of a single-part scanline EXR (a single-channel file is replicated to grey); alpha and other
 // channels are ignored. Tiled files are rejected: tinyexr's tiled error paths free memory unreliably.
 static image_data read_exr(const std::string& path) {
-  const std::string bytes = read_file(path);
+  std::string bytes = read_file(path);
+  const size_t size = bytes.size();
+  bytes.resize(size + exr_read_padding, '\0');
   const auto* mem = reinterpret_cast<const unsigned char*>(bytes.data());
   EXRVersion version;
-  if (ParseEXRVersionFromMemory(&version, mem, bytes.size()) != TINYEXR_SUCCESS)
+  if (ParseEXRVersionFromMemory(&version, mem, size) != TINYEXR_SUCCESS)
     throw input_error(path, "not an OpenEXR file");
   if (version.multipart || version.non_image || version.tiled)
     throw input_error(path, "tiled, multi-part and deep OpenEXR files are not supported (write scanline RGB)");
+  const std::string type = exr_type_attribute(mem, size);
+  if (!type.empty() && type != "scanlineimage")
+    throw input_error(path, "OpenEXR image type \"" + type.substr(0, 40) + "\" is not supported (write scanline RGB)");
   exr_file_data exr;
   const char* err = nullptr;
-  if (ParseEXRHeaderFromMemory(&exr.header, &version, mem, bytes.size(), &err) != TINYEXR_SUCCESS)
+  if (ParseEXRHeaderFromMemory(&exr.header, &version, mem, size, &err) != TINYEXR_SUCCESS)
     throw input_error(path, "malformed OpenEXR header: " + take_exr_error(err, "unknown error"));
   const EXRHeader& h = exr.header;
   int rgb[3] = {find_channel(h, "R"), find_channel(h, "G"), find_channel(h, "B")};
@@ -215,7 +252,7 @@ static image_data read_exr(const std::string& path) {
   // num_channels (leaking them when it is 0) and leaves the freed pointers in place: preset the count so the
   // planes are freed, and forget the pointers afterwards so that the destructor does not free them twice.
   exr.image.num_channels = h.num_channels;
-  if (LoadEXRImageFromMemory(&exr.image, &exr.header, mem, bytes.size(), &err) != TINYEXR_SUCCESS) {
+  if (LoadEXRImageFromMemory(&exr.image, &exr.header, mem, size, &err) != TINYEXR_SUCCESS) {
     InitEXRImage(&exr.image);
     throw input_error(path, "malformed OpenEXR data: " + take_exr_error(err, "unknown error"));
   }

@@ -159,6 +159,16 @@ scene_desc load_scene_desc(const std::string& path) {
     std::string msg = e.what();
     size_t cut = msg.find("syntax error");
     throw input_error(path, line, "malformed JSON: " + (cut == std::string::npos ? msg : msg.substr(cut)));
+  } catch (const json::exception& e) {
+    // The parser's other error: out_of_range.406 for a number literal beyond double range ("1e400"). It has no
+    // byte offset; the line is that of the literal quoted in the message, when the file holds it verbatim.
+    std::string msg = e.what();
+    size_t open = msg.find('\''), close = msg.rfind('\'');
+    size_t at = open != std::string::npos && close > open + 1 ? ctx.text.find(msg.substr(open + 1, close - open - 1))
+                                                              : std::string::npos;
+    int line = at == std::string::npos ? 0 : 1 + int(std::count(ctx.text.begin(), ctx.text.begin() + long(at), '\n'));
+    size_t tag_end = msg.find("] ");
+    throw input_error(path, line, "malformed JSON: " + (tag_end == std::string::npos ? msg : msg.substr(tag_end + 2)));
   }
   check_keys(ctx, root, "the scene file", {"mesh", "camera", "image", "render", "sun", "two_sided_emitters"});
   if (!root.contains("mesh")) throw input_error(path, "missing required key \"mesh\"");

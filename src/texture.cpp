@@ -74,6 +74,44 @@ static long long uncompressed_size(const std::string& b, long long w, long long 
   return 0;
 }
 
+// False when a JPEG Huffman table (DHT) declares more than 256 codes. stb_image 2.27 (Debian 12) trusts the 16
+// code-length counts: when they sum past 256, stbi__build_huffman (stb_image.h:1990) writes past its size[257]
+// table into the rest of its decoder state (heap corruption). Walks the marker segments as stb's decoder does
+// (fill bytes skipped, entropy-coded data skipped up to the next marker; a DHT's tables are read while its
+// length lasts, bytes past the end of the file reading as 0) and checks every table it would build.
+// Files that are no JPEG to stb (no SOI marker, optionally after fill bytes, at the start) pass.
+static bool jpeg_huffman_tables_ok(const std::string& b) {
+  auto byte = [&](size_t i) { return i < b.size() ? (unsigned char)b[i] : 0u; };
+  size_t i = 0;
+  while (byte(i) == 0xFF) i++;
+  if (i == 0 || byte(i) != 0xD8) return true;
+  i++;  // after SOI
+  while (i + 1 < b.size()) {
+    unsigned m = byte(i + 1);
+    // Not a marker, a fill byte, stuffing, TEM or RSTn/SOI/EOI (no length field): move on.
+    if (byte(i) != 0xFF || m == 0xFF || m == 0x00 || m == 0x01 || (m >= 0xD0 && m <= 0xD9)) {
+      i++;
+      continue;
+    }
+    long length = long(byte(i + 2) << 8 | byte(i + 3));
+    if (m != 0xC4) {
+      i += 2 + size_t(length);
+      continue;
+    }
+    long left = length - 2;
+    size_t p = i + 4;
+    while (left > 0) {
+      long codes = 0;
+      for (size_t k = 1; k <= 16; k++) codes += long(byte(p + k));
+      if (codes > 256) return false;
+      p += 17 + size_t(codes);
+      left -= 17 + codes;
+    }
+    i = p;
+  }
+  return true;
+}
+
 // stb_image's reason for the last failure (never null).
 static std::string stb_reason() {
   const char* r = stbi_failure_reason();
@@ -117,10 +155,15 @@ texture_data load_texture(const std::string& path) {
     throw input_error(path,
                       std::string("unsupported image format ") + fmt + " (use 8- or 16-bit PNG, JPEG, BMP or TGA)");
   if (!accepted_format(bytes, path)) throw input_error(path, "cannot decode image: not a PNG, JPEG, BMP or TGA file");
+  if (!jpeg_huffman_tables_ok(bytes))
+    throw input_error(path, "cannot decode image: corrupt JPEG (Huffman table with more than 256 codes)");
   auto data = reinterpret_cast<const stbi_uc*>(bytes.data());
   int len = int(bytes.size());
   int w = 0, h = 0, n = 0;
   if (!stbi_info_from_memory(data, len, &w, &h, &n)) throw input_error(path, "cannot decode image: " + stb_reason());
+  // stb_image 2.27's BMP info reports a top-down BMP (negative height in the file) with its negative height;
+  // its decoder uses the magnitude. INT_MIN has none (abs() would overflow in stb) and stays rejected below.
+  if (h < 0 && h != std::numeric_limits<int>::min() && bytes.compare(0, 2, "BM") == 0) h = -h;
   if (w <= 0 || h <= 0 || n < 1 || n > 4) throw input_error(path, "cannot decode image: bad header");
   long long texels = (long long)w * h;
   if (texels > max_texture_texels)
