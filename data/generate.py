@@ -5,14 +5,16 @@ Run `python3 data/generate.py` to rewrite every scene under data/ in place; the 
 every run (all randomness comes from random.Random with fixed seeds, every number is written with at most
 6 significant digits). Standard library only. Units are metres, Y is up.
 
-Scenes: cornell (sanity), living_room (simple occlusion: sun through windows + shaded lamps),
-plant_room (complex occlusion: alpha-mapped plant leaves, bright lamps behind a half-open door),
-hall (many lights: ~400 small panels among shelves, pillars and a mezzanine).
+Scenes: cornell (sanity), living_room (simple occlusion: a strong sun through one small window + shaded lamps
+that light the room), plant_room (complex occlusion: alpha-mapped plant leaves, bright lamps behind a half-open
+door), hall (many lights: ~430 small panels among full-height racks, store-room bays and a mezzanine, most of
+them hidden from any given floor point).
 
 After writing, the script re-reads every file it wrote and checks it (fails loudly with SystemExit):
 indices valid, no degenerate triangles, emissive triangles wound towards their intended emission direction,
 material limits (Kd <= 0.85, Kd + Ks <= 0.95), JSON round-trip; and per-scene geometric claims with a
-small ray caster (sun only through the windows, room B lamps hidden from the camera, lamps mostly occluded).
+small ray caster (sun only through the window and its flux well below the lamps', room B lamps hidden from the
+camera, hall lamps mostly occluded, also the ones an occlusion-blind bound ranks highest).
 """
 import json
 import math
@@ -695,10 +697,12 @@ def make_cornell():
 
 # ----------------------------------------------------------------------------------------------- living room
 LR = dict(X=8.0, H=3.0, Z=6.0, T=0.2,
-          windows=[(0.9, 2.3), (3.3, 4.7), (5.7, 7.1)], sill=0.8, top=2.3,
-          sun_az=-25.0, sun_el=40.0,
+          # window openings in the right wall (x = X; the left part of the picture): clear (z0, z1), frame width
+          windows=[(3.7, 4.15)], sill=1.0, top=1.6, frame=0.03,
+          sun_az=130.0, sun_el=50.0,
           lamps=[(2.0, 2.0), (4.0, 2.0), (6.0, 2.0), (2.0, 4.2), (4.0, 4.2), (6.0, 4.2)],
-          lamp_ke=(1.0, 0.78, 0.52), lamp_scale=1000.0, sun_rgb=(1.0, 0.96, 0.88))
+          lamp_ke=(1.0, 0.78, 0.52), lamp_scale=3000.0, sun_rgb=(1.0, 0.96, 0.88),
+          shade_kd=(0.06, 0.06, 0.06))
 
 
 def make_living_room(sun_irr_lum):
@@ -714,7 +718,8 @@ def make_living_room(sun_irr_lum):
     fabric2 = m.material("chair_fabric", (0.55, 0.45, 0.25))
     timber = m.material("furniture_wood", (0.35, 0.22, 0.12))
     white_wood = m.material("white_wood", (0.70, 0.70, 0.66))
-    shade_m = m.material("lampshade", (0.60, 0.55, 0.45))
+    shade_m = m.material("lampshade", P["shade_kd"])
+    frame_m = m.material("window_frame", (0.12, 0.08, 0.05))
     cord_m = m.material("cord", (0.05, 0.05, 0.05))
     book_m = [m.material(f"book{i}", c) for i, c in enumerate(
         [(0.5, 0.1, 0.08), (0.1, 0.2, 0.45), (0.6, 0.55, 0.3), (0.12, 0.35, 0.15), (0.7, 0.68, 0.6)])]
@@ -730,15 +735,24 @@ def make_living_room(sun_irr_lum):
     m.box((-T, -T, -T), (X + T, H + T, 0.0))
     m.obj("wall_left", wall)
     m.box((-T, -T, -0.01), (0.0, H + T, Z + 0.01))
-    m.obj("wall_right", wall)
-    m.box((X, -T, -0.01), (X + T, H + T, Z + 0.01))
-    m.obj("wall_windows", wall)
-    sill, top = P["sill"], P["top"]
-    m.box((-T, -T, Z), (X + T, sill, Z + T))
-    m.box((-T, top, Z), (X + T, H + T, Z + T))
-    edges = [-T] + [x for w in P["windows"] for x in w] + [X + T]
+    m.obj("wall_front", wall)
+    m.box((-T, -T, Z), (X + T, H + T, Z + T))
+    m.obj("wall_windows", wall)  # the right wall (x = X) with the window openings
+    sill, top, fr = P["sill"], P["top"], P["frame"]
+    m.box((X, -T, -0.01), (X + T, sill - fr, Z + 0.01))
+    m.box((X, top + fr, -0.01), (X + T, H + T, Z + 0.01))
+    edges = [-0.01] + [z + s * fr for w in P["windows"] for z, s in zip(w, (-1, 1))] + [Z + 0.01]
     for i in range(0, len(edges), 2):
-        m.box((edges[i], sill - 0.01, Z), (edges[i + 1], top + 0.01, Z + T))
+        m.box((X, sill - fr - 0.01, edges[i]), (X + T, top + fr + 0.01, edges[i + 1]))
+    # dark wooden frames lining the openings (the clear opening is P["windows"] x [sill, top]); they stand
+    # 1 cm proud of the wall on both sides and reach 1 cm into the wall
+    m.obj("window_frames", frame_m)
+    for z0, z1 in P["windows"]:
+        a, b = X - 0.01, X + T + 0.01
+        m.box((a, sill - fr - 0.01, z0 - fr - 0.01), (b, sill, z1 + fr + 0.01))
+        m.box((a, top, z0 - fr - 0.01), (b, top + fr + 0.01, z1 + fr + 0.01))
+        m.box((a, sill - fr - 0.01, z0 - fr - 0.01), (b, top + fr + 0.01, z0))
+        m.box((a, sill - fr - 0.01, z1), (b, top + fr + 0.01, z1 + fr + 0.01))
     m.obj("ground", grass)
     cxh, czh = X / 2, Z / 2
     m.quad((cxh - 30, -0.05, czh - 30), (cxh - 30, -0.05, czh + 30), (cxh + 30, -0.05, czh + 30),
@@ -796,7 +810,8 @@ def make_living_room(sun_irr_lum):
                 m.box((7.96 - dep, y + 0.025, z), (7.965, y + 0.03 + hgt, z + w))
             z += w + 0.004
 
-    # ceiling lamps: emitter disk r=7 cm (10 tris) facing down inside an opaque cone shade
+    # ceiling lamps: emitter disk r=7 cm (10 tris) facing down inside an opaque black cone shade (a bright
+    # lining would turn each shade into a small, very bright secondary source)
     for i, (lx, lz) in enumerate(P["lamps"]):
         m.obj(f"lamp{i}_shade", shade_m)
         # shade: radius 0.21 at the rim (y 2.20) to 0.15 at the top (y 2.55), closed on top; seen from
@@ -816,7 +831,90 @@ def make_living_room(sun_irr_lum):
     return m, files, sc, camera, sun_d, sun_rgb
 
 
-def check_living_room(m, sc, camera, sun_d):
+def tri_normal(sc, ti):
+    a, b, c = (sc["pos"][i] for i in sc["tris"][ti])
+    return norm(cross(sub(b, a), sub(c, a)))
+
+
+def cosine_dir(rng, n):
+    """Cosine-distributed direction about the unit vector n."""
+    u1, u2 = rng.random(), rng.random()
+    r, phi = math.sqrt(u1), 2 * math.pi * u2
+    t = norm(cross(n, (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 1.0, 0.0)))
+    b = cross(n, t)
+    return norm(add(add(mul(t, r * math.cos(phi)), mul(b, r * math.sin(phi))), mul(n, math.sqrt(max(0.0, 1 - u1)))))
+
+
+def lamp_flux(sc, tracer, is_lamp, is_fixture, rng, n_paths=4000, max_bounce=8):
+    """Flux (luminance) the emitters selected by is_lamp(object) emit in total, and the part that leaves their
+    fixtures (objects with is_fixture(object)) into the room: directly, and after diffuse bounces inside the
+    fixture (a random walk with the fixture's Kd as weight). Returns (emitted, escaped directly, escaped)."""
+    tris, pos = [], sc["pos"]
+    for ti, ((a, b, c), mt, o) in enumerate(zip(sc["tris"], sc["mtl"], sc["obj"])):
+        ke = sc["mats"][mt].get("Ke", (0, 0, 0))
+        if max(ke) > 0 and is_lamp(o):
+            pa, pb, pc = pos[a], pos[b], pos[c]
+            n = cross(sub(pb, pa), sub(pc, pa))
+            tris.append((pa, pb, pc, norm(n), math.pi * lum(ke) * 0.5 * length(n)))
+    total = sum(t[4] for t in tris)
+    direct = escaped = 0.0
+    for k in range(n_paths):
+        t = tris[k % len(tris)]
+        u, v = rng.random(), rng.random()
+        if u + v > 1:
+            u, v = 1 - u, 1 - v
+        p = add(t[0], add(mul(sub(t[1], t[0]), u), mul(sub(t[2], t[0]), v)))
+        p = add(p, mul(t[3], 1e-5))
+        d, w = cosine_dir(rng, t[3]), t[4] * len(tris) / n_paths
+        for bounce in range(max_bounce + 1):
+            h = tracer.hit(p, d, 1e4, "all")
+            if h is None or not is_fixture(h[1]):
+                escaped += w
+                direct += w if bounce == 0 else 0.0
+                break
+            n = tri_normal(sc, h[2])
+            if dot(n, d) > 0:
+                n = mul(n, -1.0)
+            w *= lum(sc["mats"][sc["mtl"][h[2]]].get("Kd", (0, 0, 0)))
+            p = add(add(p, mul(d, h[0])), mul(n, 1e-5))
+            d = cosine_dir(rng, n)
+    return total, direct, escaped
+
+
+def window_flux(sc, tracer, openings, sun_d, sun_lum, rng, n=24, n_dirs=8):
+    """Flux (luminance) entering through vertical openings, each (corner, edge u, edge v, outward normal) of
+    the inner mouth: the sun's direct flux through the outer mouth (what the reveals catch included) and
+    through the inner mouth, and the flux of the sunlit surfaces (ground, reveals, outer walls) seen through
+    the inner mouth, one diffuse bounce (black sky)."""
+    outer = inner = bounce = 0.0
+    for c0, eu, ev, nout in openings:
+        area = length(cross(eu, ev))
+        cs = dot(sun_d, nout)
+        outer += sun_lum * max(0.0, cs) * area
+        lit, lb = 0, 0.0
+        for i in range(n):
+            for j in range(n):
+                p = add(c0, add(mul(eu, (i + 0.5) / n), mul(ev, (j + 0.5) / n)))
+                if cs > 0 and tracer.hit(p, sun_d, 1e4) is None:
+                    lit += 1
+                for _ in range(n_dirs):
+                    d = cosine_dir(rng, nout)
+                    h = tracer.hit(p, d, 1e4, "all")
+                    if h is None:
+                        continue
+                    nq = tri_normal(sc, h[2])
+                    if dot(nq, d) > 0:
+                        nq = mul(nq, -1.0)
+                    cq = dot(nq, sun_d)
+                    q = add(add(p, mul(d, h[0])), mul(nq, 1e-5))
+                    if cq > 0 and tracer.hit(q, sun_d, 1e4) is None:
+                        lb += lum(sc["mats"][sc["mtl"][h[2]]]["Kd"]) * sun_lum * cq / math.pi
+        inner += sun_lum * max(0.0, cs) * area * lit / (n * n)
+        bounce += math.pi * area * lb / (n * n * n_dirs)
+    return outer, inner, bounce
+
+
+def check_living_room(m, sc, camera, sun_d, sun_lum):
     P = LR
     X, H, Z, T = P["X"], P["H"], P["Z"], P["T"]
     tr = Tracer(sc)
@@ -825,11 +923,11 @@ def check_living_room(m, sc, camera, sun_d):
     sun_d = norm(tuple(r6(c) for c in sun_d))
 
     def through_window(p):
-        # the ray p + t*sun_d must cross the window-wall slab inside an opening
-        for zz in (Z, Z + T):
-            t = (zz - p[2]) / sun_d[2]
+        # the ray p + t*sun_d must cross the window-wall slab (x in [X, X+T]) inside an opening
+        for xx in (X, X + T):
+            t = (xx - p[0]) / sun_d[0]
             q = add(p, mul(sun_d, t))
-            if not (P["sill"] <= q[1] <= P["top"] and any(a <= q[0] <= b for a, b in P["windows"])):
+            if not (P["sill"] <= q[1] <= P["top"] and any(a <= q[2] <= b for a, b in P["windows"])):
                 return False
         return True
     # 1) random interior points: whoever sees the sun sees it through a window (no leaks anywhere)
@@ -840,25 +938,19 @@ def check_living_room(m, sc, camera, sun_d):
             lit += 1
             if not through_window(p):
                 fail(f"living_room: sun leaks to {p}")
-    # 2) floor: fraction in sun, and lamp irradiance at exposed floor points
+    # 2) lamp irradiance at exposed floor points
     samples = emitter_samples(sc, split=False)
-    floor_sun, e_floor = 0, []
-    n = 0
+    e_floor = []
     for i in range(24):
         for k in range(18):
             p = ((i + 0.5) * X / 24, 1e-3, (k + 0.5) * Z / 18)
             up = tr.hit(p, (0.0, 1.0, 0.0), 2.0, True)
             if up is not None and not up.startswith("lamp"):
                 continue  # covered by furniture
-            n += 1
-            if tr.hit(p, sun_d, 1e4) is None:
-                floor_sun += 1
             e_floor.append(irradiance(tr, p, (0.0, 1.0, 0.0), samples))
     e_floor.sort()
     med = e_floor[len(e_floor) // 2]
     mean = sum(e_floor) / len(e_floor)
-    if not 0.02 < floor_sun / n < 0.4:
-        fail(f"living_room: {floor_sun}/{n} floor points in sun")
     # 3) the shade blocks part of each lamp: floor points far from a lamp get nothing from it
     shaded = sum(1 for e in e_floor if e < 0.05 * med)
     # 4) the camera sees lamps (shades), sun patches, windows
@@ -866,18 +958,34 @@ def check_living_room(m, sc, camera, sun_d):
     for i, (lx, lz) in enumerate(P["lamps"]):
         if not in_frame(camera, (lx, 2.4, lz)):
             print(f"  note: lamp{i} out of frame")
-    win_seen = sum(in_frame(camera, ((a + b) / 2, 1.5, Z)) for a, b in P["windows"])
-    if win_seen < 2:
-        fail("living_room: fewer than 2 windows in frame")
-    patch_px = 0
+    win_seen = sum(in_frame(camera, (X, (P["sill"] + P["top"]) / 2, (a + b) / 2)) for a, b in P["windows"])
+    if win_seen < len(P["windows"]):
+        fail("living_room: a window out of frame")
+    if any(project(camera, (X, 1.5, (a + b) / 2))[0] > 320 for a, b in P["windows"]):
+        fail("living_room: windows not in the left half of the picture")
+    # the sun patch on the floor: small, and most of it in view (cells of 12.5 cm)
+    patch, patch_seen = 0, 0
     for i in range(64):
         for k in range(48):
             p = ((i + 0.5) * X / 64, 1e-3, (k + 0.5) * Z / 48)
-            if tr.hit(p, sun_d, 1e4) is None and in_frame(camera, p) and tr.visible(eye, p):
-                patch_px += 1
-    if patch_px < 20:
-        fail("living_room: sun patches not visible from the camera")
-    return med, mean, floor_sun / n, lit / 3000, shaded / len(e_floor), patch_px
+            if tr.hit(p, sun_d, 1e4) is None:
+                if not through_window(p):
+                    fail(f"living_room: sun leaks to {p}")
+                patch += 1
+                patch_seen += in_frame(camera, p) and tr.visible(eye, p)
+    cell = X * Z / (64 * 48)
+    if not 0.03 <= patch * cell <= 1.0 or patch_seen < max(3, patch // 2):
+        fail(f"living_room: sun patch of {patch * cell:.3f} m2, {patch_seen}/{patch} cells seen by the camera")
+    # 5) flux (luminance): the sunlight entering through the windows against what the lamps emit into the room
+    frng = random.Random(8)
+    emitted, lamp_direct, lamp_out = lamp_flux(sc, tr, lambda o: o.startswith("lamp"),
+                                               lambda o: o.startswith("lamp"), frng)
+    openings = [((X, P["sill"], a), (0.0, 0.0, b - a), (0.0, P["top"] - P["sill"], 0.0), (1.0, 0.0, 0.0))
+                for a, b in P["windows"]]
+    outer, inner, bounce = window_flux(sc, tr, openings, sun_d, sun_lum, frng)
+    flux = dict(lamp_emitted=emitted, lamp_direct=lamp_direct, lamp_out=lamp_out, sun_outer=outer,
+                sun_inner=inner, bounce=bounce)
+    return med, mean, patch * cell, patch_seen, lit / 3000, shaded / len(e_floor), flux
 
 
 # ----------------------------------------------------------------------------------------------- plant room
@@ -1135,8 +1243,13 @@ def check_plant_room(m, sc, camera):
 
 # ----------------------------------------------------------------------------------------------- hall
 HL = dict(X=40.0, H=8.0, Z=24.0, T=0.3, mezz_z=18.0, mezz_y=4.0,
-          shelf_rows=[2.5, 5.5, 8.5, 11.5, 14.5], shelf_x=[(4.0, 16.0), (20.0, 30.0)], shelf_h=4.5,
-          partition_x=33.0, base_ke=60.0)
+          # full-height racks (back panel to 7.2 m) in rows along x; 1.6 m aisles between them
+          rack_rows=[0.75, 3.55, 6.35, 9.15, 11.95, 14.75], rack_x=[(2.0, 15.5), (18.0, 31.0)], rack_d=1.2,
+          rack_levels=[0.15, 0.95, 1.75, 2.55, 3.35, 4.15, 4.95, 5.75, 6.55, 7.15], aisle_lamp_y=7.4,
+          # a store room behind a full-height wall, split into bays by full-height walls
+          store_x=34.0, store_z=16.0, bay_walls=[4.95, 10.55],
+          ceiling_rows=[0.75, 3.55, 6.35, 9.15, 11.95, 14.75, 17.0, 19.0, 21.0, 23.0],
+          office_lamp_y=5.7, base_ke=180.0)
 
 
 def make_hall():
@@ -1173,43 +1286,58 @@ def make_hall():
     m.box((-T, -T, Z), (X + T, H + T, Z + T))
     m.box((-T, -T, -0.01), (0.0, H + T, Z + 0.01))
     m.box((X, -T, -0.01), (X + T, H + T, Z + 0.01))
-    # ground-floor partition: a 6 m high wall closing a store room at the far end
-    m.box((P["partition_x"], -0.01, -0.01), (P["partition_x"] + 0.2, 6.0, 12.0))
+    # store room: full-height walls (x = store_x towards the racks, z = store_z towards the hall), split into
+    # bays by full-height walls; every bay has a door (1.4 x 2.4 m) into the end aisle
+    sx, sz = P["store_x"], P["store_z"]
+    m.obj("store_walls", wall)
+    bays = [0.0] + P["bay_walls"] + [sz]
+    doors = [((a + b) / 2 - 0.7, (a + b) / 2 + 0.7) for a, b in zip(bays[:-1], bays[1:])]
+    edges = [-0.01] + [z for d in doors for z in d] + [sz + 0.2]
+    for i in range(0, len(edges), 2):
+        m.box((sx, -0.01, edges[i]), (sx + 0.2, H + 0.01, edges[i + 1]))
+    for d0, d1 in doors:
+        m.box((sx, 2.4, d0 - 0.01), (sx + 0.2, H + 0.01, d1 + 0.01))
+    m.box((sx - 0.01, -0.01, sz), (X + 0.01, H + 0.01, sz + 0.2))
+    for bz in P["bay_walls"]:
+        m.box((sx + 0.19, -0.01, bz - 0.1), (X + 0.01, H + 0.01, bz + 0.1))
 
-    # shelf rows along x: central back panel, uprights, 6 boards, random crates
-    for ri, zc in enumerate(P["shelf_rows"]):
-        for si, (x0, x1) in enumerate(P["shelf_x"]):
-            m.obj(f"shelf_{ri}_{si}", steel)
-            m.box((x0, -0.01, zc - 0.02), (x1, P["shelf_h"], zc + 0.02))
-            nup = int(round((x1 - x0) / 2.4))
+    # full-height racks along x: central back panel, uprights, 10 boards, random crates (fewer up high)
+    levels = P["rack_levels"]
+    hd = P["rack_d"] / 2
+    for ri, zc in enumerate(P["rack_rows"]):
+        for si, (x0, x1) in enumerate(P["rack_x"]):
+            m.obj(f"rack_{ri}_{si}", steel)
+            top = levels[-1] + 0.05
+            m.box((x0, -0.01, zc - 0.02), (x1, top, zc + 0.02))
+            nup = int(round((x1 - x0) / 2.7))
             for u in range(nup + 1):
                 ux = x0 + (x1 - x0) * u / nup
-                m.box((max(x0, ux - 0.04) if u else x0, -0.01, zc - 0.6),
-                      (min(x1, ux + 0.04) if u < nup else x1, P["shelf_h"], zc + 0.6))
+                m.box((max(x0, ux - 0.04) if u else x0, -0.01, zc - hd),
+                      (min(x1, ux + 0.04) if u < nup else x1, top, zc + hd))
             m.use(board)
-            levels = [0.15, 1.0, 1.85, 2.7, 3.55, 4.4]
             for y in levels:
-                m.box((x0 + 0.01, y, zc - 0.59), (x1 - 0.01, y + 0.04, zc + 0.59))
-            for y in levels[:-1]:
+                m.box((x0 + 0.01, y, zc - hd + 0.01), (x1 - 0.01, y + 0.04, zc + hd - 0.01))
+            for li, y in enumerate(levels[:-1]):
+                gap = levels[li + 1] - y - 0.12
                 for side in (-1, 1):
                     x = x0 + 0.1
                     while True:
-                        w = rng.uniform(0.35, 0.9)
+                        w = rng.uniform(0.4, 1.0)
                         if x + w > x1 - 0.1:
                             break
-                        if rng.random() < 0.7:
-                            hgt = rng.uniform(0.3, 0.75)
-                            dep = rng.uniform(0.3, 0.52)
+                        if rng.random() < (0.7 if li < 4 else 0.4):
+                            hgt = rng.uniform(0.3, gap)
+                            dep = rng.uniform(0.3, hd - 0.08)
                             m.use(crate_m[rng.randrange(len(crate_m))])
                             z0 = zc + 0.03 if side > 0 else zc - 0.03 - dep
                             m.box((x, y + 0.035, z0), (x + w, y + 0.04 + hgt, z0 + dep))
                         x += w + rng.uniform(0.05, 0.3)
 
-    # free-standing pillars and the mezzanine (slab, parapet, pillars, office partitions)
+    # pillars in the middle cross aisle, in line with the racks
     m.obj("pillars", pillar_m)
-    for px in (2.0, 18.0, 36.0):
-        for pz in (4.0, 10.0):
-            m.box((px - 0.3, -0.01, pz - 0.3), (px + 0.3, H + 0.01, pz + 0.3))
+    for pz in (P["rack_rows"][1], P["rack_rows"][4]):
+        m.box((16.45, -0.01, pz - 0.3), (17.05, H + 0.01, pz + 0.3))
+    # the mezzanine: slab, parapet, pillars, full-height office partitions on it
     mz, my = P["mezz_z"], P["mezz_y"]
     for px in (2.0, 8.0, 14.0, 20.0, 26.0, 32.0, 38.0):
         m.box((px - 0.25, -0.01, mz - 0.25), (px + 0.25, my - 0.19, mz + 0.25))
@@ -1233,21 +1361,27 @@ def make_hall():
             m.box((x - 0.17, y + 0.005, z - 0.17), (x + 0.17, y + 0.08, z + 0.17))
             m.box((x - 0.008, y + 0.079, z - 0.008), (x + 0.008, H + 0.02, z + 0.008))
     n = 0
-    for i in range(20):           # ceiling grid 20 x 12, 3 cm below the ceiling
-        for k in range(12):
-            lamp(f"lamp{n:03d}", 1.0 + 2.0 * i, H - 0.03, 1.0 + 2.0 * k)
+    for i in range(20):           # ceiling grid, 3 cm below the ceiling: rows above the racks (and the store
+        for zz in P["ceiling_rows"]:  # room bays), the cross aisle and the mezzanine offices
+            lamp(f"lamp{n:03d}", 1.0 + 2.0 * i, H - 0.03, zz)
             n += 1
-    for i in range(26):           # under the mezzanine, 2 rows
+    for i in range(13):           # under the mezzanine, 2 sparse rows
         for zz in (19.5, 22.5):
-            lamp(f"lamp{n:03d}", 0.75 + 1.5 * i, my - 0.23, zz)
+            lamp(f"lamp{n:03d}", 1.5 + 3.0 * i, my - 0.23, zz)
             n += 1
-    for zz in (4.0, 7.0, 10.0, 13.0):  # hanging lamps above the shelf aisles (x half-way between the
-        for i in range(26):            # ceiling lamps, so no cord passes through a ceiling panel)
-            x = 4.5 + 1.0 * i
-            if 16.0 < x < 20.0:
-                continue
-            lamp(f"lamp{n:03d}", x, 5.3, zz, hang=True)
+    for i in range(26):           # mezzanine offices: pendants above the slab, hidden from the floor below
+        for zz in (19.0, 21.0, 23.0):
+            lamp(f"lamp{n:03d}", 0.75 + 1.5 * i, P["office_lamp_y"], zz, hang=True)
             n += 1
+    rows = P["rack_rows"]
+    for za, zb in zip(rows[:-1], rows[1:]):  # one pendant row in every aisle, between the racks' tops (x on
+        zz = (za + zb) / 2                   # half metres, so no cord passes through a ceiling lamp)
+        for x0, x1 in P["rack_x"]:
+            x = x0 + 0.5
+            while x < x1:
+                lamp(f"lamp{n:03d}", x, P["aisle_lamp_y"], zz, hang=True)
+                n += 1
+                x += 1.0
 
     eye, target = (0.8, 1.7, 16.6), (30.0, 3.4, 13.0)
     camera = (eye, target, 60.0)
@@ -1257,36 +1391,85 @@ def make_hall():
 
 
 def check_hall(m, sc, camera, lamps):
+    """Occlusion statistics at random exposed floor points: the fraction of lamps seen; and, ranking the lamps
+    by an occlusion-blind bound (power x cos at the lamp x cos at the point / d^2, what the bound and bvh
+    samplers see), the fraction of the bound that is occluded and how many of the top 20 are."""
     P = HL
     tr = Tracer(sc)
     check_emitters_clear("hall", sc, tr)
     rng = random.Random(3)
-    fracs, irr = [], []
+    fracs, irr, waste, top_occ = [], [], [], []
     pts = 0
-    while pts < 40:
+    while pts < 60:
         x = (rng.uniform(0.5, P["X"] - 0.5), 1e-3, rng.uniform(0.5, P["Z"] - 0.5))
-        up = tr.hit(x, (0.0, 1.0, 0.0), 3.0, True)
-        if up is not None:
-            continue  # inside a shelf / under a board: not an exposed floor point
+        up = tr.hit(x, (0.0, 1.0, 0.0), 10.0, "all")
+        if up is not None and (up[0] < 3.0 or tri_normal(sc, up[2])[1] > 0):
+            continue  # in a rack, under a board or inside a wall: not an exposed floor point
         pts += 1
-        seen, e = 0, 0.0
+        seen, e, b_all, b_occ, ranked = 0, 0.0, 0.0, 0.0, []
         for (lx, ly, lz, kl) in lamps:
-            if tr.visible(x, (lx, ly - 0.001, lz)):
+            d2 = (lx - x[0]) ** 2 + (ly - x[1]) ** 2 + (lz - x[2]) ** 2
+            b = kl * 0.09 * (ly - x[1]) ** 2 / (d2 * d2)  # point-light bound, cos*cos/r^2
+            vis = tr.visible(x, (lx, ly - 0.001, lz))
+            ranked.append((-b, vis))
+            b_all += b
+            if vis:
                 seen += 1
-                d2 = (lx - x[0]) ** 2 + (ly - x[1]) ** 2 + (lz - x[2]) ** 2
-                e += kl * 0.09 * (ly - x[1]) ** 2 / (d2 * d2)  # point-light estimate, cos*cos/r^2
+                e += b
+            else:
+                b_occ += b
+        ranked.sort()
         fracs.append(seen / len(lamps))
         irr.append(e)
-    fracs.sort()
-    irr.sort()
-    med = fracs[len(fracs) // 2]
-    if med > 0.5:
-        fail(f"hall: median visible-lamp fraction {med:.2f} > 0.5")
+        waste.append(b_occ / b_all)
+        top_occ.append(sum(1 for _, v in ranked[:20] if not v) / 20)
+    for a in (fracs, irr, waste, top_occ):
+        a.sort()
+    h = len(fracs) // 2
+    if fracs[h] > 0.5:
+        fail(f"hall: median visible-lamp fraction {fracs[h]:.2f} > 0.5")
+    if waste[h] < 0.6 or top_occ[h] < 0.5:
+        fail(f"hall: median occluded bound share {waste[h]:.2f} / top-20 occluded {top_occ[h]:.2f} too low")
     visible_cam = sum(1 for (lx, ly, lz, _) in lamps
                       if in_frame(camera, (lx, ly, lz)) and tr.visible(camera[0], (lx, ly - 0.001, lz)))
-    if visible_cam < 30:
+    if visible_cam < 20:
         fail("hall: too few lamps visible from the camera")
-    return med, fracs[0], fracs[-1], visible_cam, irr[len(irr) // 2]
+    # the same occluded bound share at what the camera sees (24 x 18 pixel centres; the surface normal
+    # enters the bound as cos at the point)
+    eye, target, fov = camera
+    f = norm(sub(target, eye))
+    r = norm(cross(f, (0.0, 1.0, 0.0)))
+    u = cross(r, f)
+    t = math.tan(math.radians(fov) / 2)
+    pix = []
+    for j in range(18):
+        for i in range(24):
+            d = norm(add(f, add(mul(r, ((i + 0.5) / 12 - 1) * t * 4 / 3), mul(u, (1 - (j + 0.5) / 9) * t))))
+            hh = tr.hit(eye, d, 1e4, "all")
+            if hh is None or hh[1].startswith("lamp"):
+                continue
+            nx = tri_normal(sc, hh[2])
+            if dot(nx, d) > 0:
+                nx = mul(nx, -1.0)
+            x = add(add(eye, mul(d, hh[0])), mul(nx, 1e-4))
+            b_all = b_occ = 0.0
+            for (lx, ly, lz, kl) in lamps:
+                w = (lx - x[0], ly - x[1], lz - x[2])
+                d2 = dot(w, w)
+                cc = dot(nx, w) * w[1] / d2  # cos at the point x cos at the (downward) lamp, times d^2
+                if cc <= 0 or w[1] <= 0:
+                    continue
+                b_all += kl * cc / d2
+                if not tr.visible(x, (lx, ly - 0.001, lz)):
+                    b_occ += kl * cc / d2
+            if b_all > 0:
+                pix.append(b_occ / b_all)
+    pix.sort()
+    if pix[len(pix) // 2] < 0.6:
+        fail(f"hall: median occluded bound share over the picture {pix[len(pix) // 2]:.2f} too low")
+    return dict(med=fracs[h], lo=fracs[0], hi=fracs[-1], vc=visible_cam, e_med=irr[h], waste=waste[h],
+                waste_q=(waste[len(waste) // 4], waste[3 * len(waste) // 4]), top=top_occ[h],
+                pix=(pix[len(pix) // 4], pix[len(pix) // 2], pix[3 * len(pix) // 4]))
 
 
 # ----------------------------------------------------------------------------------------------- main
@@ -1296,20 +1479,31 @@ def main():
     t, e = summary(m, sc, files, info)
     rows.append(("cornell", t, e, files))
 
-    # living room: the sun's irradiance is fixed from a first pass that measures the lamps
-    LR_SUN_IRRADIANCE = 400.0  # luminance of the sun's normal irradiance (target ratio ~500 x lamps)
+    # living room: the sun's irradiance is ~400 x (normal) and ~300 x (on the floor plane) the lamps' median
+    # floor irradiance (2.15, measured by the checks), and only one small window lets it in
+    LR_SUN_IRRADIANCE = 860.0  # luminance
     m, files, sc, camera, sun_d, sun_rgb = make_living_room(LR_SUN_IRRADIANCE)
-    med, mean, fsun, lit, shaded, patch = check_living_room(m, sc, camera, sun_d)
+    med, mean, patch_m2, patch_seen, lit, shaded, fx = check_living_room(m, sc, camera, sun_d, LR_SUN_IRRADIANCE)
     ratio = LR_SUN_IRRADIANCE / med
     if not 300 <= ratio <= 1000:
         fail(f"living_room: sun/lamp irradiance ratio {ratio:.0f} outside [300, 1000]")
+    win = fx["sun_inner"] + fx["bounce"]
+    win_ratio = win / fx["lamp_out"]
+    if win_ratio > 0.3:
+        fail(f"living_room: flux through the window is {win_ratio:.2f} of the lamps' (want < 0.3)")
     info = (f"  sun dir {[fmt(c) for c in sun_d]} (az {LR['sun_az']}, el {LR['sun_el']} deg), "
             f"irradiance {[fmt(c) for c in sun_rgb]} (luminance {LR_SUN_IRRADIANCE})\n"
             f"  lamp floor irradiance (luminance, exposed floor): median {med:.4f}, mean {mean:.4f}; "
             f"sun/median-lamp ratio {ratio:.0f} (floor-plane sun irradiance "
             f"{LR_SUN_IRRADIANCE * sun_d[1]:.0f}, ratio {LR_SUN_IRRADIANCE * sun_d[1] / med:.0f})\n"
-            f"  floor in sun {100 * fsun:.1f}%, random interior points in sun {100 * lit:.1f}%, "
-            f"floor with <5% of median lamp light {100 * shaded:.1f}%, sunlit floor cells seen by camera {patch}")
+            f"  sun patch on the floor {patch_m2:.3f} m2 ({patch_seen} cells of 12.5 cm seen by the camera), "
+            f"random interior points in sun {100 * lit:.2f}%, floor with <5% of median lamp light "
+            f"{100 * shaded:.1f}%\n"
+            f"  flux (luminance): lamps emit {fx['lamp_emitted']:.1f}, {fx['lamp_out']:.1f} of it leaves the "
+            f"shades ({fx['lamp_direct']:.1f} directly). Window: direct sun {fx['sun_inner']:.1f} "
+            f"({fx['sun_outer']:.1f} at the outer mouth, before the frame), sunlit ground/frame/walls seen through "
+            f"it {fx['bounce']:.1f}; total {win:.1f} = {win_ratio:.3f} x the lamps' "
+            f"({(fx['sun_outer'] + fx['bounce']) / fx['lamp_emitted']:.3f} of all they emit, outer mouth)")
     t, e = summary(m, sc, files, info)
     rows.append(("living_room", t, e, files))
 
@@ -1322,10 +1516,14 @@ def main():
     rows.append(("plant_room", t, e, files))
 
     m, files, sc, camera, lamps = make_hall()
-    med, lo, hi, vc, e_med = check_hall(m, sc, camera, lamps)
-    info = (f"  lamps {len(lamps)}; fraction of lamps visible from floor points: median {med:.2f} "
-            f"(min {lo:.2f}, max {hi:.2f}); lamps visible in the camera view {vc}; "
-            f"median floor irradiance {e_med:.3f}")
+    hs = check_hall(m, sc, camera, lamps)
+    info = (f"  lamps {len(lamps)}; fraction of lamps visible from floor points: median {hs['med']:.2f} "
+            f"(min {hs['lo']:.2f}, max {hs['hi']:.2f}); lamps visible in the camera view {hs['vc']}; "
+            f"median floor irradiance {hs['e_med']:.3f}\n"
+            f"  occlusion-blind bound (power cos cos / d^2) at floor points: occluded share median "
+            f"{hs['waste']:.2f} (quartiles {hs['waste_q'][0]:.2f}, {hs['waste_q'][1]:.2f}); of the 20 lamps it "
+            f"ranks highest, {100 * hs['top']:.0f}% are occluded (median point); occluded share over the "
+            f"camera's view: median {hs['pix'][1]:.2f} (quartiles {hs['pix'][0]:.2f}, {hs['pix'][2]:.2f})")
     t, e = summary(m, sc, files, info)
     rows.append(("hall", t, e, files))
 
