@@ -172,14 +172,23 @@ int run_render(const render_options& o) {
   if (!o.reference.empty())
     for (int f = 0; f < params.frames; f++) references.push_back(load_reference(frame_path(o.reference, f), params));
   for (const image_data& r : references) params.frame_references.push_back(&r);
+  auto t_load = std::chrono::steady_clock::now();
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
   if (scene.mesh.dropped_degenerate > 0)
     std::fprintf(stderr, "%s: dropped %d degenerate (zero-area) triangles\n", desc.mesh_path.c_str(),
                  scene.mesh.dropped_degenerate);
+  auto t_bvh = std::chrono::steady_clock::now();
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", o.scene.c_str());
+  if (!o.quiet) {
+    auto t_end = std::chrono::steady_clock::now();
+    std::fprintf(stderr, "%s: %zu triangles, %d lights%s; loaded in %.2f s, Embree BVH and lights in %.2f s\n",
+                 o.scene.c_str(), scene.tri_area.size(), lights.count, lights.sun != invalid_id ? " (sun included)" : "",
+                 std::chrono::duration<double>(t_bvh - t_load).count(),
+                 std::chrono::duration<double>(t_end - t_bvh).count());
+  }
 
   uint64_t fingerprint = render_fingerprint(scene, params);
   if (!o.resume.empty())

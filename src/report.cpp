@@ -1,9 +1,17 @@
 // report: CSV and summary formatting (numbers with enough digits to round-trip).
 #include "report.h"
 
+#include <sys/resource.h>
+
 #include <cstdio>
 
 namespace bl {
+
+size_t peak_memory_bytes() {
+  rusage u{};
+  if (getrusage(RUSAGE_SELF, &u) != 0) return 0;
+  return size_t(u.ru_maxrss) * 1024;  // Linux reports kilobytes
+}
 
 std::string pass_log_csv(const std::string& sampler, const std::vector<pass_record>& log) {
   std::string s = "sampler,pass,spp,seconds,relmse,mse\n";
@@ -37,6 +45,12 @@ std::string render_summary(const render_result& r, const std::vector<std::string
                   double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));
     s += buf;
   }
+  if (r.setup_seconds >= 0.01) {
+    std::snprintf(buf, sizeof buf, "; set-up %.2f s (light tree, regions)", r.setup_seconds);
+    s += buf;
+  }
+  std::snprintf(buf, sizeof buf, "; peak memory %.0f MB", double(peak_memory_bytes()) / (1 << 20));
+  s += buf;
   if (st.bad_samples > 0) s += "; " + std::to_string(st.bad_samples) + " non-finite samples discarded";
   if (r.spp > 0) {
     s += " -> ";

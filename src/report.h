@@ -12,5 +12,7 @@ namespace bl {
 std::string pass_log_csv(const std::string& sampler, const std::vector<pass_record>& log);
 // "rendered N spp in T s (P passes, R Mrays/s) -> files" for stderr.
 std::string render_summary(const render_result& r, const std::vector<std::string>& outputs);
+// Peak resident memory of this process so far (bytes; 0 when unknown).
+size_t peak_memory_bytes();
 
 }  // namespace bl

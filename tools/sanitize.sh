@@ -16,6 +16,14 @@ built=$(date +%s)
 # Leaks are checked (LeakSanitizer is part of ASan on x86-64 Linux); stack-use-after-return is not (it makes
 # TBB worker stacks expensive for little gain in this code). abort_on_error gives a core-style stop in CTest.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:strict_string_checks=1:check_initialization_order=1:detect_invalid_pointer_pairs=0}
+# LeakSanitizer needs ptrace; some containers forbid it (LSan then aborts every process). Probe once with the
+# built binary and, if leak checking cannot run here, say so and go on with ASan + UBSan alone.
+if ! "$build/bayeslight" --help >/dev/null 2>"$build/lsan_probe.txt"; then
+  if grep -q "LeakSanitizer has encountered a fatal error" "$build/lsan_probe.txt"; then
+    echo "sanitize: LeakSanitizer cannot run on this machine (no ptrace); leak checks off" >&2
+    export ASAN_OPTIONS=${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0}
+  fi
+fi
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 
 (cd "$build" && ctest --output-on-failure -j "$jobs")
