@@ -125,7 +125,7 @@ void BM_region_lookup(benchmark::State& state) {
   }
   state.SetLabel(state.range(0) == 0 ? "visible" : "any_surface");
   state.counters["regions"] = double(h.regions.key.size());
-  state.counters["table_KiB"] = double(h.regions.table.size() * sizeof(region_slot)) / 1024;
+  state.counters["table_KiB"] = double(h.regions.table.size() * sizeof(region_entry)) / 1024;
   state.counters["fine_hit"] = double(fine) / double(pts.size());
 }
 BENCHMARK(BM_region_lookup)->Arg(0)->Arg(1);

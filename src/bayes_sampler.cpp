@@ -3,9 +3,18 @@
 
 #include "cluster_bounds.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <xmmintrin.h>
 
 namespace bl {
+
+namespace {
+
+// Prior scale of a point: a Lambertian point of albedo a turns irradiance E into radiance a E / pi.
+double point_scale(float albedo) { return double((albedo > 0 ? albedo : 1.0f) * inv_pi_f); }
+
+}  // namespace
 
 void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   locate_region(ctx, regions, sp);
@@ -15,9 +24,12 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
     ctx.cdf[1] = 1;
     return;
   }
-  size_t base = size_t(regions.pair_offset[size_t(ctx.region)]);
-  // Prior scale: a Lambertian point of albedo a turns irradiance E into radiance a E / pi.
-  double scale = (sp.albedo > 0 ? sp.albedo : 1.0f) * inv_pi_f;
+  if (params.region_prior) {
+    prepare_region_prior(ctx, sp);
+    return;
+  }
+  size_t base = size_t(ctx.pair_base);
+  double scale = point_scale(sp.albedo);
   float num[max_cut_entries + 3], inv_d2[max_cut_entries + 3];
   eval_node_bounds(*tree, ctx.nodes, ctx.tree_count, sp.p, sp.n, num, inv_d2);
   if (ctx.tree_count < ctx.count)
@@ -69,17 +81,75 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   if (!finish_cdf(ctx, w)) finish_cdf(ctx, b);
 }
 
+void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) const {
+  // w_j = W_j g_j with g_j = 1 / max(|p - c_j|^2, r_j^2) (1 without the regression), and 0 when the cluster's
+  // bounding sphere lies entirely behind the surface: dot(n, p - c_j) >= r_j (plus a rounding slack), where no
+  // light of it can give a non-zero sample (the BSDF is zero below the geometric tangent plane). Four tree
+  // clusters at a time; the sun (last, if any) is zero when its whole disk is below the tangent plane.
+  size_t base = size_t(ctx.pair_base);
+  const float* W = stats.w.data() + base;
+  const float* mu0 = stats.mu0.data() + base;
+  alignas(16) float wf[max_cut_entries + 3], gf[max_cut_entries + 3];
+  const int tc = ctx.tree_count;
+  const __m128 px = _mm_set1_ps(sp.p.x), py = _mm_set1_ps(sp.p.y), pz = _mm_set1_ps(sp.p.z);
+  const __m128 nx = _mm_set1_ps(sp.n.x), ny = _mm_set1_ps(sp.n.y), nz = _mm_set1_ps(sp.n.z);
+  const __m128 one = _mm_set1_ps(1.0f), slack = _mm_set1_ps(1e-5f);
+  const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  const bool regression = params.distance_regression;
+  for (int j0 = 0; j0 < tc; j0 += 4) {
+    // (cx, cy, cz, r) of four nodes (missing lanes repeat the last node; their results are never read).
+    __m128 c0 = _mm_loadu_ps(&tree->packed[size_t(ctx.nodes[std::min(j0 + 0, tc - 1)])].cx);
+    __m128 c1 = _mm_loadu_ps(&tree->packed[size_t(ctx.nodes[std::min(j0 + 1, tc - 1)])].cx);
+    __m128 c2 = _mm_loadu_ps(&tree->packed[size_t(ctx.nodes[std::min(j0 + 2, tc - 1)])].cx);
+    __m128 c3 = _mm_loadu_ps(&tree->packed[size_t(ctx.nodes[std::min(j0 + 3, tc - 1)])].cx);
+    _MM_TRANSPOSE4_PS(c0, c1, c2, c3);  // now cx, cy, cz, r
+    __m128 dx = _mm_sub_ps(px, c0), dy = _mm_sub_ps(py, c1), dz = _mm_sub_ps(pz, c2);
+    __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    __m128 g = regression ? _mm_div_ps(one, _mm_max_ps(d2, _mm_mul_ps(c3, c3))) : one;
+    __m128 dn = _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, dx), _mm_mul_ps(ny, dy)), _mm_mul_ps(nz, dz));
+    __m128 l1 = _mm_add_ps(_mm_add_ps(_mm_and_ps(dx, abs_mask), _mm_and_ps(dy, abs_mask)), _mm_and_ps(dz, abs_mask));
+    __m128 front = _mm_cmplt_ps(dn, _mm_add_ps(c3, _mm_mul_ps(slack, l1)));
+    g = _mm_and_ps(front, g);
+    _mm_store_ps(gf + j0, g);
+    _mm_store_ps(wf + j0, _mm_mul_ps(_mm_loadu_ps(W + j0), g));
+  }
+  if (tc < ctx.count) {
+    gf[tc] = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
+    wf[tc] = W[tc] * gf[tc];
+  }
+  double w[max_cut_entries];
+  for (int j = 0; j < ctx.count; j++) w[j] = wf[j];
+  // Defensive mixing with the prior-only pmf (mu0 g: the region's bound model; always a little for the naive
+  // ablation, which can starve clusters).
+  double eps = params.prior ? params.epsilon : std::max(params.epsilon, 1e-3);
+  if (eps > 0) {
+    double sum_w = 0, sum_b = 0;
+    for (int j = 0; j < ctx.count; j++) sum_w += w[j], sum_b += double(mu0[j]) * gf[j];
+    if (sum_w > 0 && sum_b > 0)
+      for (int j = 0; j < ctx.count; j++) w[j] = (1 - eps) * w[j] / sum_w + eps * double(mu0[j]) * gf[j] / sum_b;
+  }
+  if (finish_cdf(ctx, w)) return;
+  // Overflowing weights (absurd radiance scales) fall back to the prior model, then to every cluster in front.
+  for (int j = 0; j < ctx.count; j++) w[j] = double(mu0[j]) * gf[j];
+  if (finish_cdf(ctx, w)) return;
+  for (int j = 0; j < ctx.count; j++) w[j] = gf[j] > 0 ? 1.0 : 0.0;
+  finish_cdf(ctx, w);
+}
+
 void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   const cut_context& ctx = *e.context;
-  row.requests.add(regions, ctx);
+  row.requests.add(ctx);
   int j = e.choice.cluster;
   if (j < 0 || ctx.count == 1) return;
   double z = e.value;
-  if (z > 0 && params.distance_regression) {
-    double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
-    z *= d * d;
+  if (z > 0) {
+    if (params.region_prior) z /= point_scale(ctx.albedo);  // the albedo-free sample (see bayes_stats)
+    if (params.distance_regression) {
+      double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
+      z *= d * d;
+    }
   }
-  row.add(regions.pair_offset[size_t(ctx.region)] + j, z);
+  row.add(ctx.pair_base + j, z);
 }
 
 void bayes_sampler::begin_frame(double decay) {
@@ -88,15 +158,82 @@ void bayes_sampler::begin_frame(double decay) {
   refresh_weights(stats, &regions.pair_parent, params);
 }
 
+void bayes_sampler::add_pairs(int first_region) {
+  resize_stats(stats, regions.pairs, params);
+  if (!params.region_prior) return;
+  // mu0 of each pair: the region bound's distance-free part over the (padded) region box, i.e. a prior mean of
+  // z = E d^2 for a receiver facing the cluster (E / d^2 at the box centre without the regression); the sun's is
+  // its irradiance. Each region independently (the result does not depend on how the range is split).
+  float sun_mu0 = lights->sun != invalid_id ? luminance(lights->sun_irradiance) : 0.0f;
+  bool regression = params.distance_regression;
+  int end = int(regions.key.size());
+  tbb::parallel_for(tbb::blocked_range<int>(first_region, end, 64), [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); r++) {
+      bbox3f box = padded(region_box(regions.grid, regions.key[size_t(r)]));
+      vec3f mid = center(box);
+      const int* nodes = regions.cut_nodes.data() + regions.cut_offset[size_t(r)];
+      float* out = stats.mu0.data() + regions.pair_offset[size_t(r)];
+      for (int j = 0; j < regions.cut_size[size_t(r)]; j++) {
+        int node = nodes[j];
+        if (node == sun_cluster) {
+          out[j] = sun_mu0;
+          continue;
+        }
+        float m = node_region_intensity(*tree, node, box.lo, box.hi);
+        if (!regression) {
+          float d = cluster_distance(*tree, node, mid);
+          m /= d * d;
+        }
+        out[j] = m;
+      }
+    }
+  });
+}
+
+void bayes_sampler::rebuild_posterior() {
+  size_t n = stats.n0.size();
+  stats.coeffs.resize(n);
+  stats.weight.resize(n);
+  stats.mu0.assign(n, 0.0f);
+  stats.w.assign(n + 4, 0.0f);
+  add_pairs(0);
+  for (size_t i = 0; i < n; i++) update_coeffs(stats, i, params);
+  refresh_weights(stats, &regions.pair_parent, params);
+}
+
 void bayes_sampler::learn(std::vector<row_state>& rows) {
   if (frozen) return;
-  merge_rows(stats, rows, params, params.hierarchy > 0 ? &regions.pair_parent : nullptr);
+  const std::vector<int>* parents = params.hierarchy > 0 ? &regions.pair_parent : nullptr;
+  std::vector<uint8_t> touched = merge_rows(stats, rows, params, parents);
+  int before = int(regions.key.size());
   std::vector<const region_requests*> r;
   for (const row_state& row : rows) r.push_back(&row.requests);
   create_requested_regions(regions, *tree, r);
-  resize_stats(stats, regions.pairs, params);
-  // Fold each pair's (hierarchical) p1 into its sampling weight: one sequential sweep over the pairs.
-  refresh_weights(stats, &regions.pair_parent, params);
+  add_pairs(before);
+  // Fold each pair's (hierarchical) p1 into its sampling weight where anything it depends on changed: its own
+  // statistics, its parent pair's, or it is new. Every other pair's weight would come out bit for bit the same.
+  std::vector<uint8_t> region_touched(size_t(before), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, before, 256), [&](const tbb::blocked_range<int>& range) {
+    for (int k = range.begin(); k < range.end(); k++) {
+      size_t o = size_t(regions.pair_offset[size_t(k)]);
+      for (int j = 0; j < regions.cut_size[size_t(k)]; j++)
+        if (touched[o + size_t(j)]) {
+          region_touched[size_t(k)] = 1;
+          break;
+        }
+    }
+  });
+  int end = int(regions.key.size());
+  tbb::parallel_for(tbb::blocked_range<int>(0, end, 256), [&](const tbb::blocked_range<int>& range) {
+    for (int k = range.begin(); k < range.end(); k++) {
+      int up = regions.parent[size_t(k)];
+      bool stale = k >= before || region_touched[size_t(k)] || (up != invalid_id && region_touched[size_t(up)]);
+      if (!stale) continue;
+      size_t o = size_t(regions.pair_offset[size_t(k)]);
+      for (int j = 0; j < regions.cut_size[size_t(k)]; j++)
+        fold_weight(stats, o + size_t(j), parents ? (*parents)[o + size_t(j)] : invalid_id, params);
+    }
+  });
 }
 
 }  // namespace bl

@@ -27,12 +27,20 @@ struct bayes_sampler {
 
   void locate(context& ctx, const shade_point& sp) const { locate_region(ctx, regions, sp); }
   void prepare(context& ctx, const shade_point& sp) const;
+  // Region-prior mode's weights at a point (prepare's fast path): W of each pair times 1 / d^2, zero for clusters
+  // entirely behind the point's surface.
+  void prepare_region_prior(context& ctx, const shade_point& sp) const;
   light_choice sample(const context& ctx, double u, double u_inner) const {
     return sample_cut(ctx, *tree, *lights, u, u_inner);
   }
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
   void record(row_state& row, const nee_event<context>& e) const;
   void learn(std::vector<row_state>& rows);
+  // Sizes the statistics for every region and sets the region-level prior means of the pairs of regions
+  // [first_region, end) (a function of each region's box and cut only). Weights are refolded by the caller.
+  void add_pairs(int first_region);
+  // Recomputes every derived column (prior means, coefficients, weights) from the regions and statistics.
+  void rebuild_posterior();
   // Scales every statistic by `decay` (the prior regains weight) and refreshes the weights.
   void begin_frame(double decay);
 };

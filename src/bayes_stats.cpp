@@ -19,6 +19,8 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   s.m2.resize(n, 0.0);
   s.coeffs.resize(n);
   s.weight.resize(n);
+  s.mu0.resize(n, 0.0f);
+  s.w.resize(n + 4, 0.0f);
   if (n > old) {
     // All empty pairs share the prior-only coefficients (and, without data anywhere, the same weight).
     update_coeffs(s, old, p);
@@ -26,6 +28,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
     for (size_t i = old + 1; i < n; i++) {
       s.coeffs[i] = s.coeffs[old];
       s.weight[i] = s.weight[old];
+      s.w[i] = s.w[old];
     }
   }
 }
@@ -132,8 +135,8 @@ static void merge_accum(bayes_stats& s, size_t i, const pair_accum& a) {
   }
 }
 
-void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
-                const std::vector<int>* parents) {
+std::vector<uint8_t> merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
+                                const std::vector<int>* parents) {
   auto parent_of = [parents](int pair) { return parents ? (*parents)[size_t(pair)] : invalid_id; };
   // Fold in row order (sequential: the order fixes the floating-point result), collecting each touched pair once.
   std::vector<uint8_t> seen(s.n0.size(), 0);
@@ -152,6 +155,7 @@ void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_
   tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t k = r.begin(); k < r.end(); k++) update_coeffs(s, size_t(touched[k]), p);
   });
+  return seen;
 }
 
 double posterior_weight(const bayes_params& p, double bound, double scale, double d, double n0, double n1,

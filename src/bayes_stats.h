@@ -17,18 +17,23 @@ namespace bl {
 
 // Prior strengths and ablation switches.
 struct bayes_params {
-  double a0 = 1, b0 = 1;         // Beta prior of the zero-sample probability p0
+  double a0 = 1, b0 = 0.03;      // Beta prior of the zero-sample probability p0 (b0 << a0: a cluster is believed
+                                 // mostly occluded until it shows non-zero samples; see README, choosing the defaults)
   double kappa0 = 1;             // prior pseudo-count of the mean
   double alpha0 = 2;             // inverse-gamma shape (> 1)
-  double c = 1;                  // prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1)
+  double c = 0.3;                // prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1)
   double epsilon = 0;            // defensive mixing with the bound pmf
   bool second_moment = true;     // false: pmf from the posterior mean only (ablation)
   bool distance_regression = true;  // false: z = Y, no 1/d^2 model (ablation)
   bool prior = true;             // false: plug-in sample moments, the naive adaptive method (ablation)
   double decay = 1;              // statistics scale per animation frame (1: keep everything)
   int oracle_spp = 0;            // > 0: learn for this many spp first (independent seed), then freeze (oracle mode)
-  double hierarchy = 4;          // concentration of a fine pair's Beta prior on p0, centred on its coarse parent's
+  double hierarchy = 1;          // concentration of a fine pair's Beta prior on p0, centred on its coarse parent's
                                  // posterior mean (0: no hierarchy, every pair uses Beta(a0, b0))
+  bool region_prior = true;      // true: prior mean mu0 per (region, cluster) from the bound over the region's box,
+                                 // so a shading point only scales each pair's posterior weight by 1 / d^2 (the
+                                 // regression) and drops clusters behind its surface; false (ablation): mu0 from the
+                                 // bound at every shading point, which then evaluates full cone bounds per cluster
 };
 
 // Statistics columns, one entry per (region, cluster) pair, with the posterior folded into per-pair
@@ -48,10 +53,15 @@ struct pair_weight {
   float w2, w1, w0, wc;
 };
 
+// Region-prior mode (bayes_params::region_prior): observations are recorded as z = (Y / s) d^2 with s = albedo / pi
+// of the shading point (an irradiance times d^2, free of the surface's albedo), mu0 is fixed per pair when its region
+// is created, and the weight at a point is w = W g with W = sqrt(p1 max(w2 mu0^2 + w1 mu0 + w0, wc mu0^2)) per pair.
 struct bayes_stats {
   std::vector<double> n0, n1, mean, m2;  // statistics: read and written between passes only
   std::vector<pair_coeffs> coeffs;       // posterior per pair without the hierarchy (between passes only)
-  std::vector<pair_weight> weight;       // read by every shading point
+  std::vector<pair_weight> weight;       // read by every shading point (point-prior mode)
+  std::vector<float> mu0;                // region-prior mode: the pair's prior mean of z (set with its region)
+  std::vector<float> w;                  // region-prior mode: W per pair (+ 4 padding entries for SSE loads)
 };
 
 // Grows the columns to `pairs` entries (new pairs start empty, with prior-only coefficients and weights).
@@ -67,10 +77,13 @@ inline double pair_p1(const bayes_stats& s, size_t i, int up, const bayes_params
   return (p.hierarchy * double(s.coeffs[size_t(up)].p1) + s.n1[i]) / (p.hierarchy + s.n0[i] + s.n1[i]);
 }
 // Folds pair i's p1 into its sampling weight.
+inline double eval_weight(const pair_weight& h, const bayes_params& p, double v, double g);
 inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
   double p1 = pair_p1(s, i, up, p);
   const pair_coeffs& c = s.coeffs[i];
   s.weight[i] = {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
+  // With v = mu0 g the weight is g times its value at g = 1 (see pair_coeffs): W = eval_weight(v = mu0, g = 1).
+  if (p.region_prior) s.w[i] = float(eval_weight(s.weight[i], p, s.mu0[i], 1.0));
 }
 // Folds every pair's p1 into its weight (parents: region_state::pair_parent, or nullptr for none): the sweep
 // that ends learning between passes.
@@ -101,9 +114,10 @@ struct bayes_row {
 
 // Folds the rows, in order, into the statistics (Chan's parallel update) — each accumulator into its pair and
 // into that pair's parent (`parents` = region_state::pair_parent, or nullptr for none) — and refreshes the
-// coefficients of the pairs touched. Weights are not refolded (see fold_weight).
-void merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
-                const std::vector<int>* parents);
+// coefficients of the pairs touched. Weights are not refolded (see fold_weight). Returns the touched pairs
+// flagged in a per-pair byte column.
+std::vector<uint8_t> merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
+                                const std::vector<int>* parents);
 
 // Reference form of the weight (the conjugate posterior written out, in double): sqrt((1 - p0)(k^2 + h)) / d^2
 // (or the ablations) from a pair's statistics and mu0 = scale * bound * d^2. eval_weight must agree with it.

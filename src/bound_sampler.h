@@ -26,7 +26,7 @@ struct bound_sampler {
     return sample_cut(ctx, *tree, *lights, u, u_inner);
   }
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
-  void record(row_state& row, const nee_event<context>& e) const { row.add(regions, *e.context); }
+  void record(row_state& row, const nee_event<context>& e) const { row.add(*e.context); }
   void learn(std::vector<row_state>& rows);
   void begin_frame(double) {}  // regions and cuts do not depend on the sun's direction
 };

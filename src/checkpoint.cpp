@@ -113,14 +113,7 @@ void read_regions(reader& r, region_state& s) {
       r.fail("region layout");
   if (!s.pending.empty() && (s.pending.size() & (s.pending.size() - 1)) != 0) r.fail("pending table size");
   // The lookup table is rebuilt from the keys (its layout does not matter, its answers do).
-  size_t want = 16;
-  while (want < 2 * n) want *= 2;
-  s.table.assign(want, region_slot{empty_region_key, invalid_id});
-  for (size_t i = 0; i < n; i++) {
-    size_t mask = want - 1, h = size_t(mix64(s.key[i])) & mask;
-    while (s.table[h].key != empty_region_key) h = (h + 1) & mask;
-    s.table[h] = {s.key[i], int(i)};
-  }
+  rebuild_region_table(s);
 }
 
 void write_sampler(writer& w, const light_sampler& ls) {
@@ -152,11 +145,9 @@ void read_sampler(reader& r, light_sampler& ls) {
     b->stats.mean = r.column<double>(pairs);
     b->stats.m2 = r.column<double>(pairs);
     b->frozen = r.value<uint8_t>() != 0;
-    // Coefficients and weights are functions of the statistics: recompute them (bit for bit the same).
-    b->stats.coeffs.resize(pairs);
-    b->stats.weight.resize(pairs);
-    for (size_t i = 0; i < pairs; i++) update_coeffs(b->stats, i, b->params);
-    refresh_weights(b->stats, &b->regions.pair_parent, b->params);
+    // Prior means, coefficients and weights are functions of the regions and statistics: recompute them (bit for
+    // bit the same).
+    b->rebuild_posterior();
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
     read_regions(r, d->deeper.regions);
@@ -198,6 +189,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   const bayes_params& b = p.sampler.bayes;
   h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
+  h.value(b.region_prior);
   h.value(b.oracle_spp);
   const donikian_params& d = p.sampler.donikian;
   h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);

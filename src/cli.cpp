@@ -54,6 +54,7 @@ struct render_options {
   region_params regions;
   bayes_params bayes;
   std::string bayes_pmf = "second-moment";
+  std::string bayes_prior = "region";
   int frames = 1;
   double frame_decay = 0.5;
   std::string checkpoint;
@@ -108,6 +109,7 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.sampler.regions = o.regions;
   p.sampler.bayes = o.bayes;
   p.sampler.bayes.second_moment = o.bayes_pmf == "second-moment";
+  p.sampler.bayes.region_prior = o.bayes_prior == "region";
   p.frames = o.frames;
   p.frame_decay = o.frame_decay;
   p.progress = !o.quiet && stderr_is_terminal();
@@ -276,27 +278,31 @@ void add_render_options(CLI::App* r, render_options& o) {
   const char* bg = "Bayesian sampler (bayes): prior strengths and ablations";
   r->add_option("--bayes-pmf", o.bayes_pmf, "second-moment (the paper) or mean (ablation: PMF from the mean only)")
       ->check(CLI::IsMember({"second-moment", "mean"}))->group(bg);
+  r->add_option("--bayes-prior", o.bayes_prior,
+                "region (default: prior mean per region and cluster, a point only scales it by 1/d^2) or point "
+                "(ablation: prior mean from the bound at every shading point)")
+      ->check(CLI::IsMember({"region", "point"}))->group(bg);
   r->add_flag_callback("--bayes-no-regression", [&o] { o.bayes.distance_regression = false; },
                        "Ablation: no 1/d^2 distance regression (z = Y)")->group(bg);
   r->add_flag_callback("--bayes-naive", [&o] { o.bayes.prior = false; },
                        "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method)")->group(bg);
-  r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the bound PMF, in [0, 1]")
+  r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the prior-only (bound) PMF, in [0, 1] (default 0)")
       ->check(CLI::Range(0.0, 1.0))->group(bg);
-  r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (> 0)")
+  r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (> 0, default 1)")
       ->check(CLI::PositiveNumber)->group(bg);
-  r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (> 0)")
+  r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (> 0, default 0.03)")
       ->check(CLI::PositiveNumber)->group(bg);
-  r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (> 0)")
+  r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (> 0, default 1)")
       ->check(CLI::PositiveNumber)->group(bg);
-  r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1)")
+  r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1, default 2)")
       ->check(CLI::Range(1.000001, 1e9))->group(bg);
   r->add_option("--bayes-oracle", o.bayes.oracle_spp,
                 "Oracle mode: learn for this many spp first (own seed, not timed), then freeze the statistics")
       ->check(CLI::Range(0, 1 << 30))->group(bg);
   r->add_option("--bayes-hierarchy", o.bayes.hierarchy,
-                "Concentration of a fine region's Beta prior on p0, centred on its coarse parent's posterior (0 = off)")
+                "Concentration of a fine region's Beta prior on p0, centred on its coarse parent's posterior (0 = off, default 1)")
       ->check(CLI::Range(0.0, 1e9))->group(bg);
-  r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0)")
+  r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0, default 0.3)")
       ->check(CLI::PositiveNumber)->group(bg);
 }
 

@@ -19,12 +19,16 @@ void locate_region(cut_context& ctx, const region_state& regions, const shade_po
   // Neighbouring samples often fall in the same cell: reuse the last lookup (regions are frozen during a pass).
   if (key != ctx.fine_key) {
     ctx.fine_key = key;
-    int r = find_region_key(regions, key);
-    ctx.region = r != invalid_id ? r : (coarse ? regions.root : find_region(regions, key));
+    const region_entry* e = find_region_entry(regions, key);
+    if (!e && !coarse) e = find_region_entry(regions, parent_region_key(regions.grid, key, 1));
+    if (!e) e = find_region_entry(regions, regions.key[size_t(regions.root)]);
+    ctx.region = e->id;
+    ctx.region_key = e->key;
+    ctx.pair_base = e->pair_offset;
+    ctx.count = e->cut_size;
+    ctx.nodes = regions.cut_nodes.data() + e->cut_offset;
+    ctx.tree_count = ctx.count - (regions.has_sun ? 1 : 0);
   }
-  ctx.count = regions.cut_size[size_t(ctx.region)];
-  ctx.nodes = regions.cut_nodes.data() + regions.cut_offset[size_t(ctx.region)];
-  ctx.tree_count = ctx.count - (regions.has_sun ? 1 : 0);
 }
 
 bool finish_cdf(cut_context& ctx, const double* w) { return fill_cdf(w, ctx.count, ctx.cdf); }

@@ -25,13 +25,16 @@ struct cut_context {
   int pixel = invalid_id;      // (samplers that learn per pixel)
   uint64_t fine_key = ~uint64_t(0);  // the cell key looked up (fine, or coarse for deep vertices); ~0: none yet
   int region = 0;
+  uint64_t region_key = 0;     // key of `region` (differs from fine_key while the fine cell has no region yet)
+  int pair_base = 0;           // the region's first (region, cluster) pair
   int count = 0;               // clusters in the cut
   int tree_count = 0;          // of which tree nodes (the sun, if any, is last)
   const int* nodes = nullptr;  // the cut's node ids
   double cdf[max_cut_entries + 1];
 };
 
-// Fills the point and region part of a context.
+// Fills the point and region part of a context. The region part is kept while the cell stays the same (contexts
+// live for one pass, during which regions do not change).
 void locate_region(cut_context& ctx, const region_state& regions, const shade_point& sp);
 
 // Bound-based weight of cluster `node` (a tree node or sun_cluster) at (p, n): its importance, as a
@@ -76,8 +79,8 @@ struct region_requests {
     keys.clear();
     counts.clear();
   }
-  void add(const region_state& regions, const cut_context& ctx) {
-    if (regions.key[size_t(ctx.region)] == ctx.fine_key) return;
+  void add(const cut_context& ctx) {
+    if (ctx.region_key == ctx.fine_key) return;
     if (!keys.empty() && keys.back() == ctx.fine_key) {
       counts.back()++;
       return;

@@ -67,7 +67,7 @@ void donikian_sampler::prepare(context& ctx, const shade_point& sp) const {
 void donikian_sampler::record(row_state& row, const nee_event<context>& e) const {
   const cut_context& ctx = *e.context;
   if (ctx.pixel == invalid_id) {
-    row.requests.add(deeper.regions, ctx);
+    row.requests.add(ctx);
     return;
   }
   int j = e.choice.cluster;

@@ -238,7 +238,27 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
   for (size_t i = 0; i < nodes; i++)
     t.packed[i] = {t.center[i].x, t.center[i].y, t.center[i].z, t.radius[i], t.axis[i].x, t.axis[i].y, t.axis[i].z,
                    t.cos_o[i],    t.sin_o[i],    t.intensity[i], 0,           0};
+  // Descent probabilities once per node (the same double expression the descent used to evaluate per visit).
+  t.left_prob.assign(nodes, 0.0);
+  for (size_t i = 0; i < nodes; i++)
+    if (t.light[i] == invalid_id) t.left_prob[i] = left_share(t.intensity[size_t(t.left[i])], t.intensity[size_t(t.right[i])]);
   return t;
+}
+
+float node_region_intensity(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
+  size_t i = size_t(node);
+  vec3f cb = (lo + hi) * 0.5f;
+  float rb = 0.5f * length(hi - lo);
+  vec3f to_b = cb - t.center[i];
+  float d = length(to_b);
+  float r = rb + t.radius[i];
+  float sin_b = 0, cos_b = -1;
+  if (d > r) {
+    sin_b = r / d;
+    cos_b = safe_sqrt(1 - sin_b * sin_b);
+  }
+  vec3f w = d > 0 ? to_b / d : vec3f{0, 0, 1};
+  return t.intensity[i] * node_emitter_cos_bound(t, node, w, sin_b, cos_b);
 }
 
 float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
@@ -261,9 +281,7 @@ float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi) 
 }
 
 // Probability of taking the left child of an interior node when descending by intensity.
-static double left_probability(const light_tree_data& t, int node) {
-  return left_share(t.intensity[size_t(t.left[size_t(node)])], t.intensity[size_t(t.right[size_t(node)])]);
-}
+static double left_probability(const light_tree_data& t, int node) { return t.left_prob[size_t(node)]; }
 
 double intensity_descent_pmf(const light_tree_data& t, int node, int leaf) {
   // Collect the path bottom-up, then multiply top-down: the same products as sample_by_intensity.

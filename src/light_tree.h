@@ -35,6 +35,7 @@ struct light_tree_data {
   std::vector<int> light;             // leaf: its light id; interior: invalid_id
   std::vector<int> leaf_of_light;     // per triangle light id: its leaf node
   std::vector<node_pack> packed;      // the columns importance reads, one record per node
+  std::vector<double> left_prob;      // interior: probability of the left child when descending by intensity
   bool two_sided = false;
   int depth = 0;                      // longest root-to-leaf path (edges)
 };
@@ -109,6 +110,10 @@ inline float node_importance(const light_tree_data& t, int node, vec3f p, vec3f 
 // intensity * emitter cos bound over directions between the two boxes / squared box-to-box distance
 // (clamped below by the square of the region's half diagonal so that nearby nodes rank first, not infinitely).
 float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi);
+// The distance-free part of that bound: intensity * emitter cos bound over the directions between the node's and
+// the box's bounding spheres; E d^2 of a receiver facing the node (E its irradiance, d the distance to the node's
+// centre) is about this or less. The region-level prior mean of the bayes sampler.
+float node_region_intensity(const light_tree_data& t, int node, vec3f lo, vec3f hi);
 
 // Probability of the left child when descending by weights (il, ir): il / (il + ir) in double, kept inside
 // [min_positive_share, 1 - min_positive_share] when both are positive so that no positive child starves.

@@ -25,11 +25,12 @@ void key_cell(uint64_t key, int& i, int& j, int& k) {
   k = int((key >> 42) & 0xfffff);
 }
 
-void table_insert(region_state& s, uint64_t key, int id) {
+void table_insert(region_state& s, int id) {
   size_t mask = s.table.size() - 1;
-  size_t h = size_t(mix64(key)) & mask;
+  size_t r = size_t(id);
+  size_t h = size_t(mix64(s.key[r])) & mask;
   while (s.table[h].key != empty_region_key) h = (h + 1) & mask;
-  s.table[h] = {key, id};
+  s.table[h] = {s.key[r], id, s.cut_size[r], s.cut_offset[r], s.pair_offset[r]};
 }
 
 // Grows the table to keep its load at most 1/2 for `regions` entries.
@@ -37,8 +38,8 @@ void reserve_table(region_state& s, size_t regions) {
   size_t want = 16;
   while (want < 2 * regions) want *= 2;
   if (want <= s.table.size()) return;
-  s.table.assign(want, region_slot{empty_region_key, invalid_id});
-  for (size_t r = 0; r < s.key.size(); r++) table_insert(s, s.key[r], int(r));
+  s.table.assign(want, region_entry{empty_region_key, invalid_id, 0, 0, 0});
+  for (size_t r = 0; r < s.key.size(); r++) table_insert(s, int(r));
 }
 
 // Appends a region with the given cut (or the shared cut 0) under `parent` (or invalid_id), linking each of
@@ -75,20 +76,18 @@ int append_region(region_state& s, uint64_t key, const std::vector<int>* cut, in
     }
   }
   reserve_table(s, s.key.size());
-  table_insert(s, key, id);
+  table_insert(s, id);
   return id;
 }
 
 
 
-// Bounds are evaluated over the cell grown by a small margin, so points that round onto a neighbouring cell
-// are still covered by the conservative bound.
+}  // namespace
+
 bbox3f padded(const bbox3f& b) {
   vec3f m = extent(b) * 1e-3f;
   return {b.lo - m, b.hi + m};
 }
-
-}  // namespace
 
 region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree, bool has_sun,
                                const region_params& params) {
@@ -205,13 +204,23 @@ void remove_pending(region_state& s, uint64_t key) {
   s.pending_count--;
 }
 
-int find_region_key(const region_state& s, uint64_t key) {
+const region_entry* find_region_entry(const region_state& s, uint64_t key) {
   size_t mask = s.table.size() - 1;
   for (size_t h = size_t(mix64(key)) & mask;; h = (h + 1) & mask) {
-    const region_slot& slot = s.table[h];
-    if (slot.key == key) return slot.id;
-    if (slot.key == empty_region_key) return invalid_id;
+    const region_entry& slot = s.table[h];
+    if (slot.key == key) return &slot;
+    if (slot.key == empty_region_key) return nullptr;
   }
+}
+
+int find_region_key(const region_state& s, uint64_t key) {
+  const region_entry* e = find_region_entry(s, key);
+  return e ? e->id : invalid_id;
+}
+
+void rebuild_region_table(region_state& s) {
+  s.table.clear();
+  reserve_table(s, s.key.size());
 }
 
 int find_region(const region_state& s, uint64_t fine_key) {
@@ -311,7 +320,7 @@ std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool
 
 size_t region_memory_bytes(const region_state& s) {
   return s.key.size() * (sizeof(uint64_t) + 4 * sizeof(int)) + (s.cut_nodes.size() + s.pair_parent.size()) * sizeof(int) +
-         (s.table.size() + s.pending.size()) * sizeof(region_slot);
+         s.table.size() * sizeof(region_entry) + s.pending.size() * sizeof(region_slot);
 }
 
 }  // namespace bl

@@ -39,10 +39,16 @@ struct region_grid_data {
   int dims[region_levels][3];
 };
 
-// One slot of the key -> region table (key and id together: one cache line per probe).
+// One slot of a key -> count table (pending region requests).
 struct region_slot {
   uint64_t key;
   int id;
+};
+// One slot of the key -> region table: the key with everything a shading point needs of its region, so that a
+// lookup touches one cache line.
+struct region_entry {
+  uint64_t key;
+  int id, cut_size, cut_offset, pair_offset;
 };
 
 // Regions as flat columns, plus the key -> region lookup table.
@@ -59,7 +65,7 @@ struct region_state {
   std::vector<int> cut_nodes;          // concatenated sorted cuts (tree node ids, then sun_cluster)
   std::vector<int> pair_parent;        // per pair: the parent region's pair of the same cluster, or invalid_id
   int64_t pairs = 0;                   // total (region, cluster) pairs
-  std::vector<region_slot> table;      // open addressing; empty slots hold empty_region_key
+  std::vector<region_entry> table;     // open addressing; empty slots hold empty_region_key
   std::vector<region_slot> pending;    // fine keys not yet created -> NEE samples requested so far (same scheme)
   size_t pending_count = 0;
   int root = 0;
@@ -79,8 +85,15 @@ inline bool is_coarse_key(uint64_t key) { return (key >> 62) == 1; }
 uint64_t parent_region_key(const region_grid_data& g, uint64_t fine_key, int level);
 // Box of the cell with this key.
 bbox3f region_box(const region_grid_data& g, uint64_t key);
+// The box grown by a small margin: bounds are evaluated over it, so points that round onto a neighbouring cell
+// are still covered by a conservative bound.
+bbox3f padded(const bbox3f& b);
 // Region id of a key, or invalid_id.
 int find_region_key(const region_state& s, uint64_t key);
+// The table entry of a key, or nullptr.
+const region_entry* find_region_entry(const region_state& s, uint64_t key);
+// Rebuilds the key -> region table from the region columns.
+void rebuild_region_table(region_state& s);
 // The finest existing region containing the fine cell `fine_key` (the root at worst).
 int find_region(const region_state& s, uint64_t fine_key);
 

@@ -185,6 +185,36 @@ shade_point pixel_point(const test_scene& t, int x, int y) {
   return shade_point{sp.p, sp.ng, 0.5f, y * t.in.camera.width + x, 1};
 }
 
+// The prior of cluster j of a prepared context at pt in the sampler's mode, as the arguments of posterior_weight:
+// the weight is posterior_weight(p, bound, scale, d, ...) with mu0 = scale * bound * d^2 the prior mean of z. Point
+// prior: the bound at the point and scale = albedo / pi (z = Y d^2). Region prior: bound = mu0_j g_j of the pair and
+// scale = 1 (z = (Y / (albedo / pi)) d^2). `prior_weight` is the prior-only weight the sampler mixes and falls back
+// to (the bound, or mu0 g), and `y_per_z` turns a z into the sample Y that records it.
+struct prior_args {
+  double bound, scale, d, prior_weight, y_per_z;
+};
+prior_args prior_of(const test_scene& t, const bayes_sampler& s, const cut_context& ctx, int j, const shade_point& pt) {
+  prior_args a;
+  double point_scale = pt.albedo * inv_pi_f;
+  a.d = cluster_distance(t.tree, ctx.nodes[j], pt.p);
+  if (s.params.region_prior) {
+    // Without the regression the sampler's weight is W itself (no g), and mu0 is a mean of Y / (albedo / pi).
+    double g = 1 / (a.d * a.d);
+    a.bound = double(s.stats.mu0[size_t(ctx.pair_base + j)]) * (s.params.distance_regression ? g : 1.0);
+    a.scale = 1;
+    a.prior_weight = a.bound;
+    a.y_per_z = point_scale * g;
+  } else {
+    float inv_d2;
+    float num = cluster_bound_parts(t.tree, t.lights, ctx.nodes[j], pt.p, pt.n, 0, 1, inv_d2);
+    a.bound = double(num) * inv_d2;
+    a.scale = point_scale;
+    a.prior_weight = a.bound;
+    a.y_per_z = 1 / (a.d * a.d);
+  }
+  return a;
+}
+
 }  // namespace
 
 TEST_CASE("the reference posterior weight is the conjugate Normal inverse gamma and Beta posterior", "[bayes]") {
@@ -311,6 +341,7 @@ TEST_CASE("a bayes sampler without data picks clusters like the bound sampler", 
     pb.regions.max_cut = 5;
     sampler_params py = pb;
     py.kind = sampler_kind::bayes;
+    py.bayes.region_prior = false;  // the per-point prior (region_prior: see the test below)
     light_sampler lb = make_light_sampler(pb, t->in, t->tree), ly = make_light_sampler(py, t->in, t->tree);
     const bound_sampler& sb = std::get<bound_sampler>(lb);
     const bayes_sampler& sy = std::get<bayes_sampler>(ly);
@@ -332,6 +363,66 @@ TEST_CASE("a bayes sampler without data picks clusters like the bound sampler", 
     }
     INFO("sun " << sun << ": " << compared << " light pmfs compared, worst |diff| / (1e-5 pmf + 3e-7) " << worst);
     CHECK(worst <= 1);
+  }
+}
+
+TEST_CASE("with the region prior a bayes sampler without data weighs clusters by mu0 over d^2", "[bayes]") {
+  // Prior only: w_j = const * mu0_j g_j, with mu0_j the distance-free region bound of the cluster over the padded
+  // region box (the sun: its irradiance), g_j = 1 / max(|p - c_j|^2, r_j^2), and w_j = 0 exactly when the cluster's
+  // bounding sphere lies behind the point's surface.
+  for (bool sun : {true, false}) {
+    auto t = make_scene(12, sun);
+    sampler_params py;
+    py.kind = sampler_kind::bayes;
+    py.regions.max_cut = 5;
+    REQUIRE(py.bayes.region_prior);
+    light_sampler ly = make_light_sampler(py, t->in, t->tree);
+    const bayes_sampler& sy = std::get<bayes_sampler>(ly);
+    auto cy = std::make_unique<cut_context>();
+    pcg32 rng(59, 7);
+    int compared = 0, behind = 0, in_front = 0;
+    double worst = 0;
+    for (int k = 0; k < 400; k++) {
+      vec3f p = {float(-9 + 18 * unif(rng)), float(4 * unif(rng)), float(-9 + 18 * unif(rng))};
+      // Random normals, many of them facing away from some lamps.
+      vec3f n = normalize(vec3f{float(normal(rng)), float(normal(rng)), float(normal(rng))});
+      shade_point sp{p, n, float(0.1 + 0.8 * unif(rng)), 0, 1};
+      *cy = cut_context{};
+      sy.prepare(*cy, sp);
+      if (cy->count < 2) continue;
+      bbox3f box = padded(region_box(sy.regions.grid, cy->region_key));
+      double w[max_cut_entries], total = 0;
+      for (int j = 0; j < cy->count; j++) {
+        int node = cy->nodes[j];
+        double mu0, g = 1;
+        bool front;
+        if (node == sun_cluster) {
+          mu0 = luminance(t->lights.sun_irradiance);
+          front = dot(n, t->lights.sun_dir) > -sy.sun_sin;
+        } else {
+          mu0 = node_region_intensity(t->tree, node, box.lo, box.hi);
+          vec3f c = t->tree.center[size_t(node)];
+          double r = t->tree.radius[size_t(node)];
+          g = 1 / std::max(double(length_sq(p - c)), r * r);
+          front = dot(n, c - p) > -r;
+        }
+        CHECK(double(sy.stats.mu0[size_t(cy->pair_base + j)]) == mu0);
+        w[j] = front ? mu0 * g : 0;
+        (front ? in_front : behind)++;
+        total += w[j];
+      }
+      for (int j = 0; j < cy->count; j++) {
+        double want = total > 0 ? w[j] / total : 0, got = cluster_pmf(*cy, j);
+        worst = std::max(worst, std::fabs(got - want) / (1e-5 * want + 3e-7));
+        if (want == 0) CHECK(got == 0);
+        compared++;
+      }
+    }
+    INFO("sun " << sun << ": " << compared << " cluster pmfs compared (" << in_front << " in front, " << behind
+                << " behind), worst |diff| / (1e-5 pmf + 3e-7) " << worst);
+    CHECK(worst <= 1);
+    CHECK(behind > 100);
+    CHECK(in_front > 100);
   }
 }
 
@@ -470,18 +561,18 @@ convergence_result run_convergence(const bayes_params& params, const convergence
   REQUIRE(ctx->count == 3);
   REQUIRE(s.regions.key[size_t(ctx->region)] == ctx->fine_key);  // the point's own fine region
   convergence_result r;
-  double scale = pt.albedo * inv_pi_f;
-  double d[3], k[3], h[3], dist[3];
+  // Region prior: the statistics hold the albedo-free z = (Y / (albedo / pi)) d^2.
+  double y_scale = params.region_prior ? double(pt.albedo * inv_pi_f) : 1.0;
+  double d[3], k[3], h[3], dist[3], y_per_z[3];
   for (int j = 0; j < 3; j++) {
     r.prior[j] = cluster_pmf(*ctx, j);
-    float inv_d2;
-    float num = cluster_bound_parts(t->tree, t->lights, ctx->nodes[j], pt.p, pt.n, 0, 1, inv_d2);
-    double bound = double(num) * inv_d2;
+    prior_args a = prior_of(*t, s, *ctx, j, pt);
     dist[j] = cluster_distance(t->tree, ctx->nodes[j], pt.p);
     d[j] = dist[j];
-    double mu0 = scale * bound * d[j] * d[j];  // prior mean of z = Y d^2
+    double mu0 = a.scale * a.bound * d[j] * d[j];  // prior mean of z
     k[j] = cs.factor[j] * mu0;
     h[j] = cs.cv[j] * cs.cv[j] * k[j] * k[j];
+    y_per_z[j] = a.y_per_z;
   }
   // Feed n observations per cluster over 6 passes of 4 rows.
   pcg32 rng(seed, 6);
@@ -493,14 +584,16 @@ convergence_result run_convergence(const bayes_params& params, const convergence
     for (int i = pass * n / 6; i < (pass + 1) * n / 6; i++)
       for (int j = 0; j < 3; j++) {
         float y = 0;
-        if (!(unif(rng) < cs.p0[j])) y = float(std::fabs(k[j] + std::sqrt(h[j]) * normal(rng)) / (d[j] * d[j]));
+        if (!(unif(rng) < cs.p0[j])) y = float(std::fabs(k[j] + std::sqrt(h[j]) * normal(rng)) * y_per_z[j]);
         light_choice c;
         c.cluster = j;
         c.light = j;
         s.record(rows[size_t(i % 4)], nee_event<cut_context>{ctx.get(), c, y});
         if (y > 0) {
-          // What the statistics must hold: z = Y d^2 with the regression, z = Y without.
-          double z = params.distance_regression ? double(y) * dist[j] * dist[j] : double(y);
+          // What the statistics must hold: z = Y d^2 with the regression, z = Y without (Y / (albedo / pi) with
+          // the region prior).
+          double yy = params.region_prior ? double(y) / y_scale : double(y);
+          double z = params.distance_regression ? yy * dist[j] * dist[j] : yy;
           zsum[size_t(j)] += z;
           zcount[size_t(j)] += 1;
         }
@@ -560,79 +653,88 @@ const convergence_setup setup = {{0.2, 0.6, 0.9}, {0.5, 2.0, 1.0}, {0.2, 0.1, 0.
 }  // namespace
 
 TEST_CASE("a learned pmf converges to the square root of the second moment", "[bayes]") {
-  for (const bayes_params& p : param_sets()) {
-    INFO("alpha0 " << p.alpha0 << " kappa0 " << p.kappa0);
-    check_convergence(run_convergence(p, setup, 60000, 51), 0.0);
-  }
+  for (bool region : {true, false})
+    for (bayes_params p : param_sets()) {
+      p.region_prior = region;
+      INFO("region prior " << region << " alpha0 " << p.alpha0 << " kappa0 " << p.kappa0);
+      check_convergence(run_convergence(p, setup, 60000, 51), 0.0);
+    }
 }
 
 TEST_CASE("the bayes ablations learn what their definitions say", "[bayes]") {
-  SECTION("mean only: the pmf follows the posterior mean over d^2") {
-    bayes_params p;
-    p.second_moment = false;
-    check_convergence(run_convergence(p, setup, 60000, 53), 0.0);
-  }
-  SECTION("no prior: plug-in moments mixed with 1e-3 of the bound pmf") {
-    bayes_params p;
-    p.prior = false;
-    check_convergence(run_convergence(p, setup, 60000, 55), 1e-3);
-  }
-  SECTION("no distance regression: the statistics pool Y itself") {
-    bayes_params p;
-    p.distance_regression = false;
-    check_convergence(run_convergence(p, setup, 60000, 57), 0.0);
+  for (bool region : {true, false}) {
+    INFO("region prior " << region);
+    bayes_params base;
+    base.region_prior = region;
+    SECTION("mean only: the pmf follows the posterior mean over d^2") {
+      bayes_params p = base;
+      p.second_moment = false;
+      check_convergence(run_convergence(p, setup, 60000, 53), 0.0);
+    }
+    SECTION("no prior: plug-in moments mixed with 1e-3 of the prior-only pmf") {
+      bayes_params p = base;
+      p.prior = false;
+      check_convergence(run_convergence(p, setup, 60000, 55), 1e-3);
+    }
+    SECTION("no distance regression: the statistics pool Y itself") {
+      bayes_params p = base;
+      p.distance_regression = false;
+      check_convergence(run_convergence(p, setup, 60000, 57), 0.0);
+    }
   }
 }
 
 TEST_CASE("the naive ablation follows plug in moments exactly", "[bayes]") {
   // After a handful of observations the no-prior pmf is the definition: (1 - eps) w / sum w + eps b / sum b with
-  // w = sqrt(n1/n (mean^2 + m2/n1)) / d^2 (or the bound when a pair has no data) and eps = 1e-3.
-  auto t = make_scene(3, false);
-  sampler_params sp;
-  sp.kind = sampler_kind::bayes;
-  sp.bayes.prior = false;
-  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
-  bayes_sampler& s = std::get<bayes_sampler>(ls);
-  shade_point pt = pixel_point(*t, 4, 4);
-  auto ctx = std::make_unique<cut_context>();
-  s.prepare(*ctx, pt);
-  REQUIRE(ctx->count == 3);
-  double bound_pmf[3];
-  for (int j = 0; j < 3; j++) bound_pmf[j] = cluster_pmf(*ctx, j);
-  std::vector<bayes_row> rows(1);
-  const float ys[2][4] = {{0, 0.5f, 0.25f, 0}, {0, 0, 0, 0}};  // cluster 2 gets nothing
-  for (int j = 0; j < 2; j++)
-    for (float y : ys[j]) {
-      light_choice c;
-      c.cluster = j;
-      s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
+  // w = sqrt(n1/n (mean^2 + m2/n1)) / d^2 (or the prior-only weight when a pair has no data), b the prior-only
+  // weight (the bound at the point, or mu0 g with the region prior) and eps = 1e-3.
+  for (bool region : {true, false}) {
+    INFO("region prior " << region);
+    auto t = make_scene(3, false);
+    sampler_params sp;
+    sp.kind = sampler_kind::bayes;
+    sp.bayes.prior = false;
+    sp.bayes.region_prior = region;
+    light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+    bayes_sampler& s = std::get<bayes_sampler>(ls);
+    shade_point pt = pixel_point(*t, 4, 4);
+    auto ctx = std::make_unique<cut_context>();
+    s.prepare(*ctx, pt);
+    REQUIRE(ctx->count == 3);
+    double prior_pmf[3];
+    for (int j = 0; j < 3; j++) prior_pmf[j] = cluster_pmf(*ctx, j);
+    std::vector<bayes_row> rows(1);
+    const float ys[2][4] = {{0, 0.5f, 0.25f, 0}, {0, 0, 0, 0}};  // cluster 2 gets nothing
+    for (int j = 0; j < 2; j++)
+      for (float y : ys[j]) {
+        light_choice c;
+        c.cluster = j;
+        s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
+      }
+    s.learn(rows);
+    s.prepare(*ctx, pt);
+    double w[3], b[3], sw = 0, sb = 0;
+    for (int j = 0; j < 3; j++) {
+      prior_args a = prior_of(*t, s, *ctx, j, pt);
+      b[j] = a.prior_weight;
+      if (j == 0) {
+        std::vector<double> z = {0.5 / a.y_per_z, 0.25 / a.y_per_z};
+        double mean = (z[0] + z[1]) / 2, var = ((z[0] - mean) * (z[0] - mean) + (z[1] - mean) * (z[1] - mean)) / 2;
+        w[j] = std::sqrt(0.5 * (mean * mean + var)) / (a.d * a.d);
+      } else if (j == 1) {
+        w[j] = 0;  // only zeros: the naive estimate starves the cluster (the mixing keeps it alive)
+      } else {
+        w[j] = a.scale * a.bound;
+      }
+      sw += w[j];
+      sb += b[j];
     }
-  s.learn(rows);
-  s.prepare(*ctx, pt);
-  double w[3], b[3], sw = 0, sb = 0;
-  double scale = pt.albedo * inv_pi_f;
-  for (int j = 0; j < 3; j++) {
-    float inv_d2;
-    float num = cluster_bound_parts(t->tree, t->lights, ctx->nodes[j], pt.p, pt.n, 0, 1, inv_d2);
-    b[j] = double(num) * inv_d2;
-    double d = cluster_distance(t->tree, ctx->nodes[j], pt.p);
-    if (j == 0) {
-      std::vector<double> z = {0.5 * d * d, 0.25 * d * d};
-      double mean = (z[0] + z[1]) / 2, var = ((z[0] - mean) * (z[0] - mean) + (z[1] - mean) * (z[1] - mean)) / 2;
-      w[j] = std::sqrt(0.5 * (mean * mean + var)) / (d * d);
-    } else if (j == 1) {
-      w[j] = 0;  // only zeros: the naive estimate starves the cluster (the mixing keeps it alive)
-    } else {
-      w[j] = scale * b[j];
+    for (int j = 0; j < 3; j++) {
+      double expect = (1 - 1e-3) * w[j] / sw + 1e-3 * b[j] / sb;
+      INFO("cluster " << j << " prior-only pmf " << prior_pmf[j]);
+      CHECK(cluster_pmf(*ctx, j) == Approx(expect).epsilon(1e-5).margin(3e-7));
+      CHECK(cluster_pmf(*ctx, j) > 0);
     }
-    sw += w[j];
-    sb += b[j];
-  }
-  for (int j = 0; j < 3; j++) {
-    double expect = (1 - 1e-3) * w[j] / sw + 1e-3 * b[j] / sb;
-    INFO("cluster " << j << " bound pmf " << bound_pmf[j]);
-    CHECK(cluster_pmf(*ctx, j) == Approx(expect).epsilon(1e-5).margin(3e-7));
-    CHECK(cluster_pmf(*ctx, j) > 0);
   }
 }
 
@@ -640,12 +742,14 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
   // A fine pair's Beta prior on p0 is centred on its coarse parent's posterior mean with concentration s:
   // E[1 - p0] = (s p1_parent + n1) / (s + n), p1_parent = (b0 + n1_parent) / (a0 + b0 + n_parent); the rest of the
   // posterior (k, h) is the fine pair's own. Every observation of the fine pair also counts for the parent pair.
-  for (bool second_moment : {true, false}) {
-    INFO("second moment " << second_moment);
+  for (int mode = 0; mode < 4; mode++) {
+    bool second_moment = mode & 1, region = mode & 2;
+    INFO("second moment " << second_moment << " region prior " << region);
     auto t = make_scene(3, false);
     sampler_params sp;
     sp.kind = sampler_kind::bayes;
     sp.bayes.second_moment = second_moment;
+    sp.bayes.region_prior = region;
     REQUIRE(sp.bayes.hierarchy > 0);
     light_sampler ls = make_light_sampler(sp, t->in, t->tree);
     bayes_sampler& s = std::get<bayes_sampler>(ls);
@@ -684,17 +788,13 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     refresh_weights(s.stats, &s.regions.pair_parent, s.params);
     s.prepare(*ctx, pt);
     double w[3], own[3], sw = 0, sown = 0;
-    double scale = pt.albedo * inv_pi_f;
     for (int j = 0; j < 3; j++) {
       size_t i = base + size_t(j), up = size_t(s.regions.pair_parent[i]);
-      float inv_d2;
-      float num = cluster_bound_parts(t->tree, t->lights, ctx->nodes[j], pt.p, pt.n, 0, 1, inv_d2);
-      double bound = double(num) * inv_d2;
-      double d = 1 / std::sqrt(double(inv_d2));
-      double wf =
-          posterior_weight(s.params, bound, scale, d, s.stats.n0[i], s.stats.n1[i], s.stats.mean[i], s.stats.m2[i]);
-      double wp =
-          posterior_weight(s.params, bound, scale, d, s.stats.n0[up], s.stats.n1[up], s.stats.mean[up], s.stats.m2[up]);
+      prior_args a = prior_of(*t, s, *ctx, j, pt);
+      double wf = posterior_weight(s.params, a.bound, a.scale, a.d, s.stats.n0[i], s.stats.n1[i], s.stats.mean[i],
+                                   s.stats.m2[i]);
+      double wp = posterior_weight(s.params, a.bound, a.scale, a.d, s.stats.n0[up], s.stats.n1[up], s.stats.mean[up],
+                                   s.stats.m2[up]);
       const bayes_params& bp = s.params;
       double n = s.stats.n0[i] + s.stats.n1[i], np = s.stats.n0[up] + s.stats.n1[up];
       double p1_own = (bp.b0 + s.stats.n1[i]) / (bp.a0 + bp.b0 + n);
