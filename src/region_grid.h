@@ -22,7 +22,7 @@ struct region_params {
   float cut_threshold = 0.005f;    // stop refining when every cluster bound < threshold * total
   float coherence = 0.25f;         // keep a node whole when radius / gap to the region <= this and its
                                    // normals lie within 30 degrees (its lights light the region alike)
-  int shared_cut_lights = 4;       // at most this many lights: one cut of all lights, no clustering
+  int shared_cut_lights = 16;      // at most this many lights: one cut of all lights, no clustering
   int min_samples = 16;            // NEE samples a fine cell must ask for before its region is created
   int fine_depth = 1;              // path vertices up to this depth use fine regions, deeper ones coarse regions
   int64_t max_pairs = int64_t(1) << 20;  // memory budget in (region, cluster) pairs

@@ -549,9 +549,10 @@ struct convergence_result {
 };
 
 convergence_result run_convergence(const bayes_params& params, const convergence_setup& cs, int n, uint64_t seed) {
-  auto t = make_scene(3, false);  // 3 lamps: every region shares one cut of the 3 leaves
+  auto t = make_scene(3, false);  // 3 lamps (coherent quads: 3 clusters)
   sampler_params sp;
   sp.kind = sampler_kind::bayes;
+  sp.regions.shared_cut_lights = 0;  // the 3 quads form 3 clusters (not a cut of 6 leaves)
   sp.bayes = params;
   light_sampler ls = make_light_sampler(sp, t->in, t->tree);
   bayes_sampler& s = std::get<bayes_sampler>(ls);
@@ -693,6 +694,7 @@ TEST_CASE("the naive ablation follows plug in moments exactly", "[bayes]") {
     auto t = make_scene(3, false);
     sampler_params sp;
     sp.kind = sampler_kind::bayes;
+    sp.regions.shared_cut_lights = 0;  // the 3 quads form 3 clusters (not a cut of 6 leaves)
     sp.bayes.prior = false;
     sp.bayes.region_prior = region;
     light_sampler ls = make_light_sampler(sp, t->in, t->tree);
@@ -748,6 +750,7 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     auto t = make_scene(3, false);
     sampler_params sp;
     sp.kind = sampler_kind::bayes;
+    sp.regions.shared_cut_lights = 0;  // the 3 quads form 3 clusters (not a cut of 6 leaves)
     sp.bayes.second_moment = second_moment;
     sp.bayes.region_prior = region;
     REQUIRE(sp.bayes.hierarchy > 0);
