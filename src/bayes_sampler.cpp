@@ -18,6 +18,7 @@ double point_scale(float albedo) { return double((albedo > 0 ? albedo : 1.0f) * 
 
 void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   locate_region(ctx, regions, sp);
+  ctx.cv = false;
   if (ctx.count == 1) {
     // One cluster: its probability is 1 whatever was learned (and nothing is recorded for it).
     ctx.cdf[0] = 0;
@@ -87,7 +88,8 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   // light of it can give a non-zero sample (the BSDF is zero below the geometric tangent plane). Four tree
   // clusters at a time; the sun (last, if any) is zero when its whole disk is below the tangent plane.
   size_t base = size_t(ctx.pair_base);
-  const float* W = stats.w.data() + base;
+  ctx.cv = params.control_variate && sp.last;
+  const float* W = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
   const float* mu0 = stats.mu0.data() + base;
   alignas(16) float wf[max_cut_entries + 3], gf[max_cut_entries + 3];
   const int tc = ctx.tree_count;
@@ -116,6 +118,16 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   if (tc < ctx.count) {
     gf[tc] = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
     wf[tc] = W[tc] * gf[tc];
+  }
+  if (ctx.cv) {
+    // c_j = (E[1 - p0] k_j) g_j, zero behind the surface like the weight; their colour-weighted sum.
+    const float* cv = stats.cv.data() + base;
+    vec3f sum = {0, 0, 0};
+    for (int j = 0; j < ctx.count; j++) {
+      ctx.cvg[j] = cv[j] * gf[j];
+      sum += cluster_color(ctx, j) * ctx.cvg[j];
+    }
+    ctx.cv_sum = sum;
   }
   double w[max_cut_entries];
   for (int j = 0; j < ctx.count; j++) w[j] = wf[j];

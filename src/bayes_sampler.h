@@ -23,6 +23,7 @@ struct bayes_sampler {
   bayes_stats stats;
   bayes_params params;
   float sun_sin = 0, sun_cos = 1;
+  vec3f sun_color = {1, 1, 1};  // the sun's irradiance over its luminance
   bool frozen = false;  // oracle mode: statistics and regions no longer change
 
   void locate(context& ctx, const shade_point& sp) const { locate_region(ctx, regions, sp); }
@@ -35,6 +36,14 @@ struct bayes_sampler {
   }
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
   void record(row_state& row, const nee_event<context>& e) const;
+  // Control variates (prepare set ctx.cv): the emission colour of cluster j (luminance 1), the colour-weighted sum
+  // of every cluster's learned mean c_j, and c_J of one cluster in colour.
+  vec3f cluster_color(const context& ctx, int j) const {
+    int node = ctx.nodes[j];
+    return node == sun_cluster ? sun_color : tree->color[size_t(node)];
+  }
+  vec3f cv_total(const context& ctx) const { return ctx.cv_sum; }
+  vec3f cv_cluster(const context& ctx, int j) const { return cluster_color(ctx, j) * ctx.cvg[j]; }
   void learn(std::vector<row_state>& rows);
   // Sizes the statistics for every region and sets the region-level prior means of the pairs of regions
   // [first_region, end) (a function of each region's box and cut only). Weights are refolded by the caller.

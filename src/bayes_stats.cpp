@@ -21,6 +21,8 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   s.weight.resize(n);
   s.mu0.resize(n, 0.0f);
   s.w.resize(n + 4, 0.0f);
+  s.w_cv.resize(n + 4, 0.0f);
+  s.cv.resize(n + 4, 0.0f);
   if (n > old) {
     // All empty pairs share the prior-only coefficients (and, without data anywhere, the same weight).
     update_coeffs(s, old, p);
@@ -29,6 +31,8 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
       s.coeffs[i] = s.coeffs[old];
       s.weight[i] = s.weight[old];
       s.w[i] = s.w[old];
+      s.w_cv[i] = s.w_cv[old];
+      s.cv[i] = s.cv[old];
     }
   }
 }
@@ -75,6 +79,23 @@ void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
     }
   }
   s.coeffs[i] = {float(q2), float(q1), float(q0), float(qc), float(p1)};
+}
+
+bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, double mu0, double& k, double& h) {
+  double n1 = s.n1[i], z = s.mean[i], m2 = s.m2[i];
+  if (!p.prior) {
+    if (s.n0[i] + n1 == 0) return false;
+    k = z;
+    h = n1 >= 2 ? m2 / n1 : 0.0;
+    return true;
+  }
+  double kn = p.kappa0 + n1;
+  k = (p.kappa0 * mu0 + n1 * z) / kn;
+  double an = p.alpha0 + 0.5 * n1;
+  double dm = z - mu0;
+  double bn = p.c * mu0 * mu0 * (p.alpha0 - 1) + 0.5 * (m2 + p.kappa0 * n1 * dm * dm / kn);
+  h = bn / (an - 1);
+  return true;
 }
 
 void bayes_row::clear() {

@@ -34,6 +34,11 @@ struct bayes_params {
                                  // so a shading point only scales each pair's posterior weight by 1 / d^2 (the
                                  // regression) and drops clusters behind its surface; false (ablation): mu0 from the
                                  // bound at every shading point, which then evaluates full cone bounds per cluster
+  double cv_min_visible = 0.98;  // control variates only for pairs with E[1 - p0] at least this
+  bool control_variate = true;   // region prior only: where NEE is unweighted (direct illumination, the last path
+                                 // vertex), add the learned mean c_j = E[1 - p0] k_j / d^2 of every cluster and
+                                 // estimate the residual (Y_J - c_J) / P_J, with P_j proportional to the root of the
+                                 // residual's second moment E[1 - p0] h + E[1 - p0] E[p0] k^2 (METHOD.md 5)
 };
 
 // Statistics columns, one entry per (region, cluster) pair, with the posterior folded into per-pair
@@ -62,7 +67,12 @@ struct bayes_stats {
   std::vector<pair_weight> weight;       // read by every shading point (point-prior mode)
   std::vector<float> mu0;                // region-prior mode: the pair's prior mean of z (set with its region)
   std::vector<float> w;                  // region-prior mode: W per pair (+ 4 padding entries for SSE loads)
+  std::vector<float> w_cv, cv;           // control variates: W of the residual, and E[1 - p0] k (+ 4 padding each)
 };
+
+// The posterior point estimates of pair i for prior mean mu0: k (mean of z) and h (variance of z); false when the
+// naive ablation has no data (then there is no learned mean).
+bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, double mu0, double& k, double& h);
 
 // Grows the columns to `pairs` entries (new pairs start empty, with prior-only coefficients and weights).
 void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p);
@@ -83,7 +93,20 @@ inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p)
   const pair_coeffs& c = s.coeffs[i];
   s.weight[i] = {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
   // With v = mu0 g the weight is g times its value at g = 1 (see pair_coeffs): W = eval_weight(v = mu0, g = 1).
-  if (p.region_prior) s.w[i] = float(eval_weight(s.weight[i], p, s.mu0[i], 1.0));
+  if (!p.region_prior) return;
+  s.w[i] = float(eval_weight(s.weight[i], p, s.mu0[i], 1.0));
+  if (!p.control_variate) return;
+  double k, h;
+  // Only for clusters the region nearly always sees: where visibility is mixed it is usually a function of
+  // position (a shadow edge through the region), and a region-wide mean would add, not remove, variance.
+  if (!p.second_moment || p1 < p.cv_min_visible || !pair_posterior(s, i, p, s.mu0[i], k, h)) {
+    s.w_cv[i] = s.w[i];  // no learned mean (or the mean-only ablation): the plain weight, no control variate
+    s.cv[i] = 0;
+    return;
+  }
+  // Residual second moment E[(Z - c)^2] with c = p1 k: p1 (k^2 + h) - p1^2 k^2 = p1 h + p1 (1 - p1) k^2.
+  s.w_cv[i] = float(std::sqrt(p1 * h + p1 * (1 - p1) * k * k));
+  s.cv[i] = float(p1 * k);
 }
 // Folds every pair's p1 into its weight (parents: region_state::pair_parent, or nullptr for none): the sweep
 // that ends learning between passes.

@@ -282,6 +282,11 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "region (default: prior mean per region and cluster, a point only scales it by 1/d^2) or point "
                 "(ablation: prior mean from the bound at every shading point)")
       ->check(CLI::IsMember({"region", "point"}))->group(bg);
+  r->add_flag_callback("--bayes-no-cv", [&o] { o.bayes.control_variate = false; },
+                       "Ablation: no control variates (with the region prior they apply where NEE is unweighted)")->group(bg);
+  r->add_option("--bayes-cv-min-visible", o.bayes.cv_min_visible,
+                "Control variates only for clusters a region sees with probability at least this (default 0.98)")
+      ->check(CLI::Range(0.0, 1.0))->group(bg);
   r->add_flag_callback("--bayes-no-regression", [&o] { o.bayes.distance_regression = false; },
                        "Ablation: no 1/d^2 distance regression (z = Y)")->group(bg);
   r->add_flag_callback("--bayes-naive", [&o] { o.bayes.prior = false; },

@@ -31,6 +31,11 @@ struct cut_context {
   int tree_count = 0;          // of which tree nodes (the sun, if any, is last)
   const int* nodes = nullptr;  // the cut's node ids
   double cdf[max_cut_entries + 1];
+  // Control variates (bayes): whether they apply at this point, sum_j colour_j c_j and c_j per cluster, with c_j
+  // the learned mean of cluster j's albedo-free sample (the integrator scales by (kd + ks) / pi).
+  bool cv = false;
+  vec3f cv_sum = {0, 0, 0};
+  float cvg[max_cut_entries + 3];
 };
 
 // Fills the point and region part of a context. The region part is kept while the cell stays the same (contexts

@@ -17,8 +17,15 @@
 #include "scene.h"
 
 #include <cstdint>
+#include <type_traits>
 
 namespace bl {
+
+// Whether a sampler offers control variates (cv_total / cv_cluster on its context).
+template <class S, class = void>
+struct has_control_variates : std::false_type {};
+template <class S>
+struct has_control_variates<S, std::void_t<decltype(&S::cv_total)>> : std::true_type {};
 
 // The read-only inputs of path sampling.
 struct render_inputs {
@@ -120,7 +127,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     vertex_randoms r = draw_vertex(key, uint32_t(depth));
     bool last = depth >= in.max_depth;
     typename Sampler::context& ctx = ctxs[depth & 1];
-    shade_point spt{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth};
+    shade_point spt{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth, last};
     tm.stop(prof_shading, t0);
     if constexpr (Timers::enabled) {
       // Profiles time the region lookup apart; prepare() then finds it cached.
@@ -156,6 +163,15 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
             radiance += beta * unweighted * (w / choice.prob);
             value = luminance(unweighted) / choice.prob_in_cluster;
           }
+        }
+      }
+      if constexpr (has_control_variates<Sampler>::value) {
+        // Control variate (unweighted NEE only): sum_j c_j + (Y_J - c_J) / P_J, the Y_J / P_J part added above;
+        // c_j in colour is the cluster's learned albedo-free mean times (kd + ks) / pi.
+        if (ctx.cv) {
+          double pj = cluster_pmf(ctx, choice.cluster);
+          vec3f c = sampler.cv_total(ctx) - sampler.cv_cluster(ctx, choice.cluster) * float(1 / pj);
+          radiance += beta * (bsdf.kd + bsdf.ks) * inv_pi_f * c;
         }
       }
       st.nee_zero += value == 0;

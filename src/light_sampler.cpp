@@ -112,6 +112,8 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.sun_sin = sun_sin;
       s.sun_cos = sun_cos;
       s.params = params.bayes;
+      if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
+        s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);
       s.regions = make_regions(params, in, tree);
       s.add_pairs(0);
       refresh_weights(s.stats, &s.regions.pair_parent, s.params);
@@ -125,7 +127,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
 size_t sampler_memory_bytes(const light_sampler& s) {
   if (auto* b = std::get_if<bound_sampler>(&s)) return region_memory_bytes(b->regions);
   if (auto* b = std::get_if<bayes_sampler>(&s))
-    return region_memory_bytes(b->regions) + b->stats.n0.size() * (4 * sizeof(double) + sizeof(pair_coeffs) + sizeof(pair_weight) + 2 * sizeof(float));
+    return region_memory_bytes(b->regions) + b->stats.n0.size() * (4 * sizeof(double) + sizeof(pair_coeffs) + sizeof(pair_weight) + 4 * sizeof(float));
   if (auto* d = std::get_if<donikian_sampler>(&s))
     return region_memory_bytes(d->deeper.regions) +
            (d->pixel_sum.size() + d->pixel_count.size() + d->block_sum.size() + d->block_count.size()) * sizeof(float);

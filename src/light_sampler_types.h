@@ -37,6 +37,7 @@ struct shade_point {
   float albedo = 0;  // luminance of the BSDF's albedos (kd + ks), scale of the expected contribution
   int pixel = 0;     // image pixel of the path
   int depth = 1;     // 1 = first hit
+  bool last = false; // the path ends here: NEE is unweighted (no MIS), so a control variate may be applied
 };
 
 // A chosen light with its selection probability; cluster is the sampler's own bookkeeping (or -1).

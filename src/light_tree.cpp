@@ -238,6 +238,32 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
   for (size_t i = 0; i < nodes; i++)
     t.packed[i] = {t.center[i].x, t.center[i].y, t.center[i].z, t.radius[i], t.axis[i].x, t.axis[i].y, t.axis[i].z,
                    t.cos_o[i],    t.sin_o[i],    t.intensity[i], 0,           0};
+  // Emission colour per node: RGB intensity over luminance intensity (children before parents, by an explicit
+  // post-order walk), white where a node emits nothing.
+  std::vector<vec3f> rgb(nodes, vec3f{0, 0, 0});
+  std::vector<int> stack = {0};
+  std::vector<int> order;
+  order.reserve(nodes);
+  while (!stack.empty()) {
+    int v = stack.back();
+    stack.pop_back();
+    order.push_back(v);
+    if (t.light[size_t(v)] == invalid_id) stack.push_back(t.left[size_t(v)]), stack.push_back(t.right[size_t(v)]);
+  }
+  for (size_t k = order.size(); k-- > 0;) {
+    size_t v = size_t(order[k]);
+    if (t.light[v] != invalid_id) {
+      int l = t.light[v];
+      rgb[v] = lights.radiance[size_t(l)] * scene.tri_area[size_t(lights.tri[size_t(l)])];
+    } else {
+      rgb[v] = rgb[size_t(t.left[v])] + rgb[size_t(t.right[v])];
+    }
+  }
+  t.color.resize(nodes);
+  for (size_t v = 0; v < nodes; v++) {
+    float y = luminance(rgb[v]);
+    t.color[v] = y > 0 ? rgb[v] / y : vec3f{1, 1, 1};
+  }
   // Descent probabilities once per node (the same double expression the descent used to evaluate per visit).
   t.left_prob.assign(nodes, 0.0);
   for (size_t i = 0; i < nodes; i++)

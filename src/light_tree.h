@@ -36,6 +36,7 @@ struct light_tree_data {
   std::vector<int> leaf_of_light;     // per triangle light id: its leaf node
   std::vector<node_pack> packed;      // the columns importance reads, one record per node
   std::vector<double> left_prob;      // interior: probability of the left child when descending by intensity
+  std::vector<vec3f> color;           // emission colour: RGB intensity / luminance intensity (luminance 1)
   bool two_sided = false;
   int depth = 0;                      // longest root-to-leaf path (edges)
 };

@@ -819,3 +819,67 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     CHECK(gap > 1e-2);  // decisive: the parent's extra data visibly moves the blend away from the fine posterior
   }
 }
+
+TEST_CASE("control variates apply at unweighted NEE to nearly always visible clusters", "[bayes]") {
+  // Cluster 0 is always visible with a steady contribution, cluster 1 is visible half the time, cluster 2 has no
+  // data. Where NEE is unweighted (sp.last) cluster 0 gets the control variate c = E[1 - p0] k g and the pmf the
+  // residual's weight sqrt(E[1 - p0] h + E[1 - p0] E[p0] k^2) g; clusters 1 and 2 (E[1 - p0] < cv_min_visible) keep
+  // the plain weight and c = 0. Elsewhere (MIS-weighted NEE) nothing changes.
+  auto t = make_scene(3, false);
+  sampler_params sp;
+  sp.kind = sampler_kind::bayes;
+  sp.regions.shared_cut_lights = 0;
+  REQUIRE(sp.bayes.control_variate);
+  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+  bayes_sampler& s = std::get<bayes_sampler>(ls);
+  shade_point pt = pixel_point(*t, 4, 4);
+  auto ctx = std::make_unique<cut_context>();
+  s.prepare(*ctx, pt);
+  REQUIRE(ctx->count == 3);
+  pcg32 rng(61, 8);
+  std::vector<bayes_row> rows(1);
+  for (int i = 0; i < 4000; i++) {
+    for (int j = 0; j < 2; j++) {
+      light_choice c;
+      c.cluster = j;
+      float y = j == 0 ? float(0.3 * (1 + 0.05 * normal(rng))) : (unif(rng) < 0.5 ? 0.0f : 0.2f);
+      s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
+    }
+  }
+  s.learn(rows);
+  for (bool last : {false, true}) {
+    INFO("last vertex " << last);
+    shade_point q = pt;
+    q.last = last;
+    *ctx = cut_context{};
+    s.prepare(*ctx, q);
+    CHECK(ctx->cv == last);
+    double w[3], sum = 0;
+    vec3f cv_sum = {0, 0, 0};
+    for (int j = 0; j < 3; j++) {
+      size_t i = size_t(ctx->pair_base + j);
+      double d = cluster_distance(t->tree, ctx->nodes[j], pt.p), g = 1 / (d * d);
+      double p1 = pair_p1(s.stats, i, s.regions.pair_parent[i], s.params), k, h;
+      bool learned = pair_posterior(s.stats, i, s.params, s.stats.mu0[i], k, h);
+      bool cv = last && j == 0;
+      CHECK((p1 >= s.params.cv_min_visible) == (j == 0));
+      if (cv) {
+        REQUIRE(learned);
+        CHECK(double(s.stats.cv[i]) == Approx(p1 * k).epsilon(1e-6));
+        CHECK(double(ctx->cvg[j]) == Approx(p1 * k * g).epsilon(1e-5));
+        w[j] = std::sqrt(p1 * h + p1 * (1 - p1) * k * k) * g;
+        CHECK(w[j] < 0.2 * double(s.stats.w[i]) * g);  // decisive: the residual is far smaller than the signal
+      } else {
+        w[j] = double(s.stats.w[i]) * g;
+        if (last) CHECK(ctx->cvg[j] == 0);
+      }
+      if (last) cv_sum += s.cluster_color(*ctx, j) * ctx->cvg[j];
+      sum += w[j];
+    }
+    for (int j = 0; j < 3; j++) CHECK(cluster_pmf(*ctx, j) == Approx(w[j] / sum).epsilon(1e-5).margin(3e-7));
+    if (last) {
+      CHECK(s.cv_total(*ctx).x == Approx(cv_sum.x));
+      CHECK(s.cv_total(*ctx).y == Approx(cv_sum.y));
+    }
+  }
+}

@@ -23,7 +23,7 @@ size_t light_bytes(const light_data& l, const light_tree_data& t) {
              l.light_of_tri.size() * sizeof(int);
   size_t nodes = size_t(node_count(t));
   b += nodes * (2 * sizeof(vec3f) + sizeof(vec3f) + sizeof(float) + sizeof(vec3f) + 3 * sizeof(float) +
-                4 * sizeof(int) + sizeof(node_pack) + sizeof(double));
+                4 * sizeof(int) + sizeof(node_pack) + sizeof(double) + sizeof(vec3f));
   return b + t.leaf_of_light.size() * sizeof(int);
 }
 
