@@ -114,19 +114,19 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     g = _mm_and_ps(front, g);
     _mm_store_ps(gf + j0, g);
     _mm_store_ps(wf + j0, _mm_mul_ps(_mm_loadu_ps(W + j0), g));
+    if (ctx.cv) _mm_storeu_ps(ctx.cvg + j0, _mm_mul_ps(_mm_loadu_ps(stats.cv.data() + base + size_t(j0)), g));
   }
   if (tc < ctx.count) {
     gf[tc] = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
     wf[tc] = W[tc] * gf[tc];
   }
   if (ctx.cv) {
-    // c_j = (E[1 - p0] k_j) g_j, zero behind the surface like the weight; their colour-weighted sum.
-    const float* cv = stats.cv.data() + base;
+    // c_j = (E[1 - p0] k_j) g_j (set above for tree clusters), zero behind the surface like the weight; their
+    // colour-weighted sum (most pairs have no control variate: c_j = 0).
+    if (tc < ctx.count) ctx.cvg[tc] = stats.cv[base + size_t(tc)] * gf[tc];
     vec3f sum = {0, 0, 0};
-    for (int j = 0; j < ctx.count; j++) {
-      ctx.cvg[j] = cv[j] * gf[j];
-      sum += cluster_color(ctx, j) * ctx.cvg[j];
-    }
+    for (int j = 0; j < ctx.count; j++)
+      if (ctx.cvg[j] != 0) sum += cluster_color(ctx, j) * ctx.cvg[j];
     ctx.cv_sum = sum;
   }
   double w[max_cut_entries];
@@ -224,26 +224,12 @@ void bayes_sampler::learn(std::vector<row_state>& rows) {
   add_pairs(before);
   // Fold each pair's (hierarchical) p1 into its sampling weight where anything it depends on changed: its own
   // statistics, its parent pair's, or it is new. Every other pair's weight would come out bit for bit the same.
-  std::vector<uint8_t> region_touched(size_t(before), 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, before, 256), [&](const tbb::blocked_range<int>& range) {
-    for (int k = range.begin(); k < range.end(); k++) {
-      size_t o = size_t(regions.pair_offset[size_t(k)]);
-      for (int j = 0; j < regions.cut_size[size_t(k)]; j++)
-        if (touched[o + size_t(j)]) {
-          region_touched[size_t(k)] = 1;
-          break;
-        }
-    }
-  });
-  int end = int(regions.key.size());
-  tbb::parallel_for(tbb::blocked_range<int>(0, end, 256), [&](const tbb::blocked_range<int>& range) {
-    for (int k = range.begin(); k < range.end(); k++) {
-      int up = regions.parent[size_t(k)];
-      bool stale = k >= before || region_touched[size_t(k)] || (up != invalid_id && region_touched[size_t(up)]);
-      if (!stale) continue;
-      size_t o = size_t(regions.pair_offset[size_t(k)]);
-      for (int j = 0; j < regions.cut_size[size_t(k)]; j++)
-        fold_weight(stats, o + size_t(j), parents ? (*parents)[o + size_t(j)] : invalid_id, params);
+  size_t old_pairs = touched.size(), pairs = stats.n0.size();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs, 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i < range.end(); i++) {
+      int up = parents ? (*parents)[i] : invalid_id;
+      bool stale = i >= old_pairs || touched[i] || (up != invalid_id && touched[size_t(up)]);
+      if (stale) fold_weight(stats, i, up, params);
     }
   });
 }

@@ -158,23 +158,32 @@ static void merge_accum(bayes_stats& s, size_t i, const pair_accum& a) {
 
 std::vector<uint8_t> merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
                                 const std::vector<int>* parents) {
-  auto parent_of = [parents](int pair) { return parents ? (*parents)[size_t(pair)] : invalid_id; };
-  // Fold in row order (sequential: the order fixes the floating-point result), collecting each touched pair once.
-  std::vector<uint8_t> seen(s.n0.size(), 0);
-  std::vector<int> touched;
-  auto touch = [&](int pair) {
-    if (!seen[size_t(pair)]) seen[size_t(pair)] = 1, touched.push_back(pair);
+  // Each accumulator updates its pair and that pair's parent. The updates of one pair must happen in row order (the
+  // order fixes the floating-point result), so accumulators are first dealt, in that order, to the buckets of the
+  // pairs they update; then buckets (disjoint pair ranges) fold in parallel. Bit for bit the sequential fold.
+  size_t n = s.n0.size();
+  std::vector<uint8_t> seen(n, 0);
+  constexpr size_t buckets = 32;
+  size_t span = std::max<size_t>(1, (n + buckets - 1) / buckets);
+  struct update {
+    const pair_accum* acc;
+    int pair;
   };
+  std::vector<std::vector<update>> work(buckets);
   for (const bayes_row& row : rows)
     for (const pair_accum& a : row.acc) {
-      merge_accum(s, size_t(a.pair), a);
-      touch(a.pair);
-      int up = parent_of(a.pair);
-      if (up != invalid_id) merge_accum(s, size_t(up), a), touch(up);
+      work[size_t(a.pair) / span].push_back({&a, a.pair});
+      int up = parents ? (*parents)[size_t(a.pair)] : invalid_id;
+      if (up != invalid_id) work[size_t(up) / span].push_back({&a, up});
     }
-  // Coefficients of the touched pairs, in parallel (each depends on its own statistics only).
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t k = r.begin(); k < r.end(); k++) update_coeffs(s, size_t(touched[k]), p);
+  tbb::parallel_for(size_t(0), buckets, [&](size_t b) {
+    std::vector<int> touched;
+    for (const update& u : work[b]) {
+      merge_accum(s, size_t(u.pair), *u.acc);
+      if (!seen[size_t(u.pair)]) seen[size_t(u.pair)] = 1, touched.push_back(u.pair);
+    }
+    // Coefficients of the touched pairs (each depends on its own statistics only).
+    for (int i : touched) update_coeffs(s, size_t(i), p);
   });
   return seen;
 }

@@ -13,14 +13,14 @@ bool fill_cdf(const double* w, int n, double* cdf) {
     for (int i = 0; i < n; i++) cdf[i + 1] = 0;
     return false;
   }
-  // Floor every positive weight so that no item that can contribute rounds to probability zero.
+  // Floor every positive weight so that no item that can contribute rounds to probability zero (written without
+  // branches: zero weights come in unpredictable patterns).
   double floor = total * min_positive_share, acc = 0;
   int last = -1;
   for (int i = 0; i < n; i++) {
-    if (w[i] > 0) {
-      acc += std::max(w[i], floor);
-      last = i;
-    }
+    bool positive = w[i] > 0;
+    acc += positive ? std::max(w[i], floor) : 0.0;
+    last = positive ? i : last;
     cdf[i + 1] = acc;
   }
   double inv = 1 / acc;

@@ -19,7 +19,7 @@ if [[ " $sections " == *" throughput "* ]]; then
     for t in 1 2; do
       printf "  %-8s threads %d: " "$s" "$t"
       "$bin" render "$scene" --sampler "$s" --spp 32 --threads "$t" --width 320 --height 240 -o "$tmp/t.pfm" 2>&1 \
-        | sed -n 's/.*(\(.*\)).*/\1/p' | head -n 1 || true
+        | sed -n 's/^rendered [^(]*(\([^)]*\)).*/\1/p' | head -n 1 || true
     done
   done
 fi
