@@ -185,10 +185,12 @@ static float exr_sample(const unsigned char* p, int pixel_type, size_t i) {
 // size (DecompressPiz, tinyexr.h:3095-3116); with the padding those reads stay inside our buffer.
 static constexpr size_t exr_read_padding = 64 * 1024;
 
-// The value of the last non-empty "type" attribute of the EXR header at mem (after the 8-byte magic and version),
-// read as tinyexr's ParseEXRHeader reads it ("" when there is none or the header is malformed: tinyexr then fails
-// on its own). tinyexr 1.0.1 asserts on type values that disagree with the version flags (ConvertHeader,
-// tinyexr.h:4536-4548), and Debian builds it with assertions on: an unknown type aborts the process.
+// The first non-empty "type" attribute of the EXR header at mem (after the 8-byte magic and version) that is not
+// "scanlineimage", read as tinyexr's ParseEXRHeader reads attributes ("" when there is none, or the header is
+// malformed: tinyexr then fails on its own). tinyexr 1.0.1 asserts on type values that disagree with the version
+// flags (ConvertHeader, tinyexr.h:4536-4548), and Debian builds it with assertions on: an unknown type aborts the
+// process. Every type attribute counts, not only the last: fuzzing found headers with two, the first one bad,
+// that still reached the assertion.
 static std::string exr_type_attribute(const unsigned char* mem, size_t size) {
   std::string type;
   size_t pos = 8;
@@ -205,10 +207,13 @@ static std::string exr_type_attribute(const unsigned char* mem, size_t size) {
                    uint32_t(mem[pos + head + 2]) << 16 | uint32_t(mem[pos + head + 3]) << 24;
     if (left - head - 4 < len) break;
     const char* data = p + head + 4;
-    if (std::strcmp(p, "type") == 0 && len > 0 && data[0] != 0) type.assign(data, strnlen(data, len));
-    for (char& c : type) c = c >= 32 && c < 127 ? c : '?';  // for the message
+    if (std::strcmp(p, "type") == 0 && len > 0 && data[0] != 0) {
+      std::string t(data, strnlen(data, len));
+      if (t != "scanlineimage" && type.empty()) type = t;
+    }
     pos += head + 4 + len;
   }
+  for (char& c : type) c = c >= 32 && c < 127 ? c : '?';  // for the message
   return type;
 }
 

@@ -113,6 +113,27 @@ static bool jpeg_huffman_tables_ok(const std::string& b) {
 }
 
 // stb_image's reason for the last failure (never null).
+// Drops the zero-length IDAT chunks of a PNG (they carry no data, so the image is unchanged): stb_image 2.27 copies
+// such a chunk with memcpy(NULL, ..., 0) before its first allocation (stb_image.h:1663, found by fuzzing), which is
+// undefined behaviour. From the first chunk that does not fit the file on, the bytes stay as they are for stb to
+// judge.
+static void drop_empty_idat_chunks(std::string& b) {
+  static const char sig[8] = {'\x89', 'P', 'N', 'G', '\r', '\n', '\x1a', '\n'};
+  if (b.size() < 8 || b.compare(0, 8, std::string(sig, 8)) != 0) return;
+  std::string out = b.substr(0, 8);
+  size_t pos = 8;
+  while (pos + 12 <= b.size()) {
+    unsigned long long len = (unsigned long long)(unsigned char)b[pos] << 24 | (unsigned char)b[pos + 1] << 16 |
+                             (unsigned char)b[pos + 2] << 8 | (unsigned char)b[pos + 3];
+    if (len > b.size() - pos - 12) break;  // truncated or corrupt: the rest stays as it is
+    bool empty_idat = len == 0 && b.compare(pos + 4, 4, "IDAT") == 0;
+    if (!empty_idat) out.append(b, pos, size_t(len) + 12);
+    pos += size_t(len) + 12;
+  }
+  out.append(b, pos, std::string::npos);
+  b.swap(out);
+}
+
 static std::string stb_reason() {
   const char* r = stbi_failure_reason();
   return r ? r : "unknown error";
@@ -157,6 +178,7 @@ texture_data load_texture(const std::string& path) {
   if (!accepted_format(bytes, path)) throw input_error(path, "cannot decode image: not a PNG, JPEG, BMP or TGA file");
   if (!jpeg_huffman_tables_ok(bytes))
     throw input_error(path, "cannot decode image: corrupt JPEG (Huffman table with more than 256 codes)");
+  drop_empty_idat_chunks(bytes);
   auto data = reinterpret_cast<const stbi_uc*>(bytes.data());
   int len = int(bytes.size());
   int w = 0, h = 0, n = 0;
