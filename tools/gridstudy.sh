@@ -1,19 +1,34 @@
 #!/usr/bin/env bash
 # Grid-resolution study (issue 4, the paper's test 3): bayes and bound on the many-light hall (direct only) with
-# the region grid at 8, 16, 32, 64, 128 and 256 cells along the shortest axis, at equal time T seconds each.
-# Error is reference-free (tools/selfvar.sh: two seeds, half the relMSE between them), so no reference noise
-# enters; the speed-up of bayes over bound is their error ratio at equal time.
-#   tools/gridstudy.sh BIN     (env: T seconds per render, default 8; W, H default 320x240; GRIDS; SCENE)
+# the region grid at 8, 16, 32, 64, 128 and 256 cells along the shortest axis, at equal time T seconds each, against
+# the reference tools/eqtable.sh caches in $(dirname BIN)/ref (rendered there when missing; the image does not depend
+# on the grid). Mean relMSE over SEEDS; the speed-up of bayes over bound is their error ratio at equal time.
+# (A reference-free error from two seeds, used before, has a noisy denominator and mis-ranked settings.)
+#   tools/gridstudy.sh BIN     (env: T seconds per render, default 8; W, H default 320x240; GRIDS; SCENE; SEEDS)
 set -euo pipefail
 bin=$1
 cd "$(dirname "$0")/.."
-T=${T:-8}
-scene=${SCENE:-data/hall/direct.json}
+T=${T:-8}; W=${W:-320}; H=${H:-240}; SEEDS=${SEEDS:-"11 22"}
+scene=${SCENE:-hall}
 grids=${GRIDS:-"8 16 32 64 128 256"}
-echo "grid study: $scene, ${W:-320}x${H:-240}, $T s per render (two seeds each), relMSE/2 between seeds"
+json=data/$scene/direct.json
+refdir=$(dirname "$bin")/ref; mkdir -p "$refdir"
+ref=$refdir/${scene}_direct_${W}x${H}_bayes_4096.exr
+[ -f "$ref" ] || "$bin" render "$json" --sampler bayes --spp 4096 --seed 987654321 --width "$W" --height "$H" -o "$ref" --quiet
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+err() {  # mean relMSE over the seeds of one configuration
+  local sum=0 n=0
+  for seed in $SEEDS; do
+    "$bin" render "$json" "$@" --time "$T" --seed "$seed" --width "$W" --height "$H" --reference "$ref" \
+      --log "$tmp/l.csv" -o "$tmp/i.pfm" --quiet
+    sum=$(awk -v s="$sum" -v e="$(tail -n 1 "$tmp/l.csv" | cut -d, -f5)" 'BEGIN { print s + e }'); n=$((n + 1))
+  done
+  awk -v s="$sum" -v n="$n" 'BEGIN { print s / n }'
+}
+echo "grid study: $json, ${W}x${H}, $T s per render, seeds $SEEDS, mean relMSE against $ref"
 printf "  %5s  %12s  %12s  %8s\n" grid bayes bound speed-up
 for g in $grids; do
-  a=$(tools/selfvar.sh "$bin" "$scene" "$T" x --sampler bayes --grid "$g" | sed -n 's/.*relmse\/2 //p')
-  b=$(tools/selfvar.sh "$bin" "$scene" "$T" x --sampler bound --grid "$g" | sed -n 's/.*relmse\/2 //p')
+  a=$(err --sampler bayes --grid "$g")
+  b=$(err --sampler bound --grid "$g")
   awk -v g="$g" -v a="$a" -v b="$b" 'BEGIN { printf "  %5d  %12.5g  %12.5g  %7.2fx\n", g, a, b, b / a }'
 done
