@@ -271,7 +271,8 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
   return t;
 }
 
-float node_region_intensity(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
+// Emitter cos bound of a node over the directions between its bounding sphere and the box's.
+static float emitter_cos_toward_box(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
   size_t i = size_t(node);
   vec3f cb = (lo + hi) * 0.5f;
   float rb = 0.5f * length(hi - lo);
@@ -284,23 +285,17 @@ float node_region_intensity(const light_tree_data& t, int node, vec3f lo, vec3f 
     cos_b = safe_sqrt(1 - sin_b * sin_b);
   }
   vec3f w = d > 0 ? to_b / d : vec3f{0, 0, 1};
-  return t.intensity[i] * node_emitter_cos_bound(t, node, w, sin_b, cos_b);
+  return node_emitter_cos_bound(t, node, w, sin_b, cos_b);
+}
+
+float node_region_intensity(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
+  return t.intensity[size_t(node)] * emitter_cos_toward_box(t, node, lo, hi);
 }
 
 float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
   size_t i = size_t(node);
-  vec3f cb = (lo + hi) * 0.5f;
   float rb = 0.5f * length(hi - lo);
-  vec3f to_b = cb - t.center[i];
-  float d = length(to_b);
-  float r = rb + t.radius[i];
-  float sin_b = 0, cos_b = -1;
-  if (d > r) {
-    sin_b = r / d;
-    cos_b = safe_sqrt(1 - sin_b * sin_b);
-  }
-  vec3f w = d > 0 ? to_b / d : vec3f{0, 0, 1};
-  float ce = node_emitter_cos_bound(t, node, w, sin_b, cos_b);
+  float ce = emitter_cos_toward_box(t, node, lo, hi);
   if (ce == 0) return 0;
   float d2 = box_distance_sq(lo, hi, t.lo[i], t.hi[i]);
   return t.intensity[i] * ce / std::max(d2, rb * rb);
