@@ -394,10 +394,10 @@ bayes_stats random_stats(size_t pairs, uint64_t seed) {
   pcg32 rng(seed, 1);
   for (size_t i = 0; i < pairs; i++) {
     if (unit(rng) < 0.3f) continue;
-    s.n0[i] = double(rng() % 100);
-    s.n1[i] = double(1 + rng() % 100);
-    s.mean[i] = std::pow(10.0, 3 * double(unit(rng)) - 1);
-    s.m2[i] = s.n1[i] * s.mean[i] * s.mean[i] * double(unit(rng));
+    s.m[i].n0 = double(rng() % 100);
+    s.m[i].n1 = double(1 + rng() % 100);
+    s.m[i].mean = std::pow(10.0, 3 * double(unit(rng)) - 1);
+    s.m[i].m2 = s.m[i].n1 * s.m[i].mean * s.m[i].mean * double(unit(rng));
   }
   return s;
 }

@@ -7,6 +7,10 @@
 #include <tbb/parallel_for.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
 namespace bl {
 
 namespace {
@@ -172,6 +176,20 @@ void bayes_sampler::begin_frame(double decay) {
 
 void bayes_sampler::add_pairs(int first_region) {
   resize_stats(stats, regions.pairs, params);
+  // Children lists of the coarse pairs (refold reaches a coarse pair's children through them).
+  size_t npairs = stats.m.size();
+  if (first_region == 0) first_child.clear(), next_sibling.clear();
+  first_child.resize(npairs, invalid_id);
+  next_sibling.resize(npairs, invalid_id);
+  for (size_t r = size_t(first_region); r < regions.key.size(); r++) {
+    size_t b = size_t(regions.pair_offset[r]), e = b + size_t(regions.cut_size[r]);
+    for (size_t k = b; k < e; k++) {
+      int up = regions.pair_parent[k];
+      if (up == invalid_id) continue;
+      next_sibling[k] = first_child[size_t(up)];
+      first_child[size_t(up)] = int(k);
+    }
+  }
   if (!params.region_prior) return;
   // mu0 of each pair: the region bound's distance-free part over the (padded) region box, i.e. a prior mean of
   // z = E d^2 for a receiver facing the cluster (E / d^2 at the box centre without the regression); the sun's is
@@ -203,7 +221,7 @@ void bayes_sampler::add_pairs(int first_region) {
 }
 
 void bayes_sampler::rebuild_posterior() {
-  size_t n = stats.n0.size();
+  size_t n = stats.m.size();
   stats.coeffs.resize(n);
   stats.weight.resize(n);
   stats.mu0.assign(n, 0.0f);
@@ -216,21 +234,61 @@ void bayes_sampler::rebuild_posterior() {
 void bayes_sampler::learn(std::vector<row_state>& rows) {
   if (frozen) return;
   const std::vector<int>* parents = params.hierarchy > 0 ? &regions.pair_parent : nullptr;
-  std::vector<uint8_t> touched = merge_rows(stats, rows, params, parents);
+  using clock = std::chrono::steady_clock;
+  auto secs = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  size_t old_pairs = stats.m.size();
+  auto t0 = clock::now();
+  std::vector<int> touched = merge_rows(stats, rows, params, parents);
+  auto t1 = clock::now();
   int before = int(regions.key.size());
   std::vector<const region_requests*> r;
   for (const row_state& row : rows) r.push_back(&row.requests);
   create_requested_regions(regions, *tree, r);
   add_pairs(before);
-  // Fold each pair's (hierarchical) p1 into its sampling weight where anything it depends on changed: its own
-  // statistics, its parent pair's, or it is new. Every other pair's weight would come out bit for bit the same.
-  size_t old_pairs = touched.size(), pairs = stats.n0.size();
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs, 4096), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t i = range.begin(); i < range.end(); i++) {
-      int up = parents ? (*parents)[i] : invalid_id;
-      bool stale = i >= old_pairs || touched[i] || (up != invalid_id && touched[size_t(up)]);
-      if (stale) fold_weight(stats, i, up, params);
+  auto t2 = clock::now();
+  refold(touched, old_pairs);
+  auto t3 = clock::now();
+  timing.reduce += secs(t0, t1);
+  timing.regions += secs(t1, t2);
+  timing.refold += secs(t2, t3);
+}
+
+void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
+  const bool hier = params.hierarchy > 0 && params.prior;
+  auto fold = [&](size_t i) { fold_weight(stats, i, hier ? regions.pair_parent[i] : invalid_id, params); };
+  // Touched pairs and new pairs: their own statistics (or prior) changed. Each pair independently.
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& g) {
+    for (size_t k = g.begin(); k < g.end(); k++) fold(size_t(touched[k]));
+  });
+  size_t pairs = stats.m.size();
+  tbb::parallel_for(tbb::blocked_range<size_t>(old_pairs, pairs, 1024), [&](const tbb::blocked_range<size_t>& g) {
+    for (size_t i = g.begin(); i < g.end(); i++) {
+      fold(i);
+      stats.p1_folded[i] = stats.coeffs[i].p1;
     }
+  });
+  if (!hier) return;
+  // Children of coarse pairs whose p1 moved by more than the tolerance since their children were last folded. A
+  // child's p1 = (s p1_parent + n1) / (s + n) moves, relative to itself, by at most the parent's relative move, so
+  // a child's p1 is never more than about twice the tolerance away from its exact value (which it gets whenever it
+  // is touched itself). The decisions depend on the statistics only: deterministic. Work: the children of the
+  // moved pairs only.
+  std::vector<int> moved;
+  const double tol = params.refold_tolerance;
+  // Below p1_floor the tolerance is absolute (tol * p1_floor): a cluster the region nearly never sees keeps a
+  // small weight either way, and whenever a child of it is sampled it is touched and refolded exactly.
+  constexpr double p1_floor = 0.1;
+  for (int i : touched) {
+    size_t k = size_t(i);
+    if (first_child[k] == invalid_id) continue;  // no children (a fine pair, or a coarse one without any yet)
+    float now = stats.coeffs[k].p1, then = stats.p1_folded[k];
+    if (!(std::fabs(double(now) - double(then)) > tol * std::max(double(then), p1_floor))) continue;
+    moved.push_back(i);
+    stats.p1_folded[k] = now;
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, moved.size(), 16), [&](const tbb::blocked_range<size_t>& g) {
+    for (size_t m = g.begin(); m < g.end(); m++)
+      for (int c = first_child[size_t(moved[m])]; c != invalid_id; c = next_sibling[size_t(c)]) fold(size_t(c));
   });
 }
 

@@ -15,6 +15,9 @@ namespace bl {
 // The Bayesian sampler; owns its regions and statistics, reads a light tree it does not own.
 struct bayes_sampler {
   static constexpr bool learns = true;
+  // Image rows per observation state: the rows of a band share one accumulator table, so a region seen by several
+  // rows of the band folds as one record between passes (fewer records, same statistics up to rounding).
+  static constexpr int rows_per_state = 4;
   using context = cut_context;
   using row_state = bayes_row;
   const light_tree_data* tree = nullptr;
@@ -25,6 +28,8 @@ struct bayes_sampler {
   float sun_sin = 0, sun_cos = 1;
   vec3f sun_color = {1, 1, 1};  // the sun's irradiance over its luminance
   bool frozen = false;  // oracle mode: statistics and regions no longer change
+  learn_timing timing;
+  std::vector<int> first_child, next_sibling;  // per pair: the fine pairs of a coarse pair, as a linked list
 
   void locate(context& ctx, const shade_point& sp) const { locate_region(ctx, regions, sp); }
   void prepare(context& ctx, const shade_point& sp) const;
@@ -48,6 +53,10 @@ struct bayes_sampler {
   // Sizes the statistics for every region and sets the region-level prior means of the pairs of regions
   // [first_region, end) (a function of each region's box and cut only). Weights are refolded by the caller.
   void add_pairs(int first_region);
+  // Refolds the weights of the pairs whose inputs changed in a pass: the touched pairs, the pairs new since
+  // `old_pairs`, and the children of coarse pairs whose p1 moved by more than the refold tolerance. Work scales
+  // with the pass's records, not with the pairs.
+  void refold(const std::vector<int>& touched, size_t old_pairs);
   // Recomputes every derived column (prior means, coefficients, weights) from the regions and statistics.
   void rebuild_posterior();
   // Scales every statistic by `decay` (the prior regains weight) and refreshes the weights.

@@ -7,16 +7,14 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <cmath>
 
 namespace bl {
 
 void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
-  size_t old = s.n0.size(), n = size_t(pairs);
-  s.n0.resize(n, 0.0);
-  s.n1.resize(n, 0.0);
-  s.mean.resize(n, 0.0);
-  s.m2.resize(n, 0.0);
+  size_t old = s.m.size(), n = size_t(pairs);
+  s.m.resize(n);
   s.coeffs.resize(n);
   s.weight.resize(n);
   s.mu0.resize(n, 0.0f);
@@ -35,19 +33,21 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
       s.cv[i] = s.cv[old];
     }
   }
+  s.p1_folded.resize(n, s.coeffs.empty() ? 1.0f : s.coeffs[n - 1].p1);
 }
 
 void decay_stats(bayes_stats& s, double gamma, const bayes_params& p) {
-  for (size_t i = 0; i < s.n0.size(); i++) {
-    s.n0[i] *= gamma;
-    s.n1[i] *= gamma;
-    s.m2[i] *= gamma;  // the mean is unchanged by scaling all weights
+  for (size_t i = 0; i < s.m.size(); i++) {
+    s.m[i].n0 *= gamma;
+    s.m[i].n1 *= gamma;
+    s.m[i].m2 *= gamma;  // the mean is unchanged by scaling all weights
     update_coeffs(s, i, p);
   }
 }
 
 void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
-  double n0 = s.n0[i], n1 = s.n1[i], z = s.mean[i], m2 = s.m2[i];
+  const pair_moments& m = s.m[i];
+  double n0 = m.n0, n1 = m.n1, z = m.mean, m2 = m.m2;
   double n = n0 + n1;
   double q2, q1 = 0, q0 = 0, qc = 0, p1;
   if (!p.prior) {
@@ -82,9 +82,9 @@ void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
 }
 
 bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, double mu0, double& k, double& h) {
-  double n1 = s.n1[i], z = s.mean[i], m2 = s.m2[i];
+  double n1 = s.m[i].n1, z = s.m[i].mean, m2 = s.m[i].m2;
   if (!p.prior) {
-    if (s.n0[i] + n1 == 0) return false;
+    if (s.m[i].n0 + n1 == 0) return false;
     k = z;
     h = n1 >= 2 ? m2 / n1 : 0.0;
     return true;
@@ -124,7 +124,7 @@ void bayes_row::add(int pair, double z) {
   if (slots[h] < 0) {
     slots[h] = int(acc.size());
     used.push_back(int(h));
-    acc.push_back({pair, 0, 0, 0, 0});
+    acc.push_back({pair, invalid_id, 0, 0, 0, 0});
   }
   pair_accum& a = acc[size_t(slots[h])];
   if (z == 0) {
@@ -140,52 +140,73 @@ void bayes_row::add(int pair, double z) {
 void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p) {
   // Every pair independently (the result does not depend on how the range is split).
   tbb::parallel_for(tbb::blocked_range<size_t>(0, s.weight.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); i++) fold_weight(s, i, parents ? (*parents)[i] : invalid_id, p);
+    for (size_t i = r.begin(); i < r.end(); i++) {
+      fold_weight(s, i, parents ? (*parents)[i] : invalid_id, p);
+      s.p1_folded[i] = s.coeffs[i].p1;
+    }
   });
 }
 
-// Chan's parallel update of pair i with an accumulator.
-static void merge_accum(bayes_stats& s, size_t i, const pair_accum& a) {
-  s.n0[i] += a.n0;
+// Chan's parallel update of a pair's statistics with an accumulator.
+static void merge_accum(pair_moments& m, const pair_accum& a) {
+  m.n0 += a.n0;
   if (a.n1 > 0) {
-    double n = s.n1[i] + a.n1;
-    double delta = a.mean - s.mean[i];
-    s.mean[i] += delta * (a.n1 / n);
-    s.m2[i] += a.m2 + delta * delta * (s.n1[i] * a.n1 / n);
-    s.n1[i] = n;
+    double n = m.n1 + a.n1;
+    double delta = a.mean - m.mean;
+    m.mean += delta * (a.n1 / n);
+    m.m2 += a.m2 + delta * delta * (m.n1 * a.n1 / n);
+    m.n1 = n;
   }
 }
 
-std::vector<uint8_t> merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
-                                const std::vector<int>* parents) {
+std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const bayes_params& p,
+                            const std::vector<int>* parents) {
   // Each accumulator updates its pair and that pair's parent. The updates of one pair must happen in row order (the
-  // order fixes the floating-point result), so accumulators are first dealt, in that order, to the buckets of the
-  // pairs they update; then buckets (disjoint pair ranges) fold in parallel. Bit for bit the sequential fold.
-  size_t n = s.n0.size();
-  std::vector<uint8_t> seen(n, 0);
-  constexpr size_t buckets = 32;
-  size_t span = std::max<size_t>(1, (n + buckets - 1) / buckets);
-  struct update {
-    const pair_accum* acc;
-    int pair;
-  };
-  std::vector<std::vector<update>> work(buckets);
-  for (const bayes_row& row : rows)
-    for (const pair_accum& a : row.acc) {
-      work[size_t(a.pair) / span].push_back({&a, a.pair});
-      int up = parents ? (*parents)[size_t(a.pair)] : invalid_id;
-      if (up != invalid_id) work[size_t(up) / span].push_back({&a, up});
-    }
-  tbb::parallel_for(size_t(0), buckets, [&](size_t b) {
-    std::vector<int> touched;
-    for (const update& u : work[b]) {
-      merge_accum(s, size_t(u.pair), *u.acc);
-      if (!seen[size_t(u.pair)]) seen[size_t(u.pair)] = 1, touched.push_back(u.pair);
-    }
-    // Coefficients of the touched pairs (each depends on its own statistics only).
-    for (int i : touched) update_coeffs(s, size_t(i), p);
+  // order fixes the floating-point result). Buckets (disjoint pair ranges) fold in parallel, each scanning every
+  // row in order and taking the updates of its own pairs: bit for bit the sequential fold for any number of buckets,
+  // so the count may follow the thread count. No per-update lists: a scan costs a few ns per accumulator.
+  size_t n = s.m.size();
+  merge_buffers& mb = s.scratch;
+  tbb::parallel_for(size_t(0), rows.size(), [&](size_t r) {
+    for (pair_accum& a : rows[r].acc) a.up = parents ? (*parents)[size_t(a.pair)] : invalid_id;
   });
-  return seen;
+  const size_t buckets = std::clamp<size_t>(4 * size_t(tbb::this_task_arena::max_concurrency()), 1, 256);
+  const size_t span = std::max<size_t>(1, (n + buckets - 1) / buckets);
+  mb.touched.resize(buckets);
+  if (mb.seen.size() < n) mb.seen.resize(n, 0);
+  tbb::parallel_for(size_t(0), buckets, [&](size_t b) {
+    std::vector<int>& touched = mb.touched[b];
+    touched.clear();
+    const unsigned lo = unsigned(b * span), len = unsigned(span);
+    auto take = [&](int pair, const pair_accum& a) {
+      if (unsigned(pair) - lo >= len) return;  // another bucket's (invalid_id wraps to a huge value)
+      merge_accum(s.m[size_t(pair)], a);
+      uint8_t& seen = mb.seen[size_t(pair)];
+      if (!seen) seen = 1, touched.push_back(pair);
+    };
+    for (const bayes_row& row : rows)
+      for (const pair_accum& a : row.acc) {
+        take(a.pair, a);
+        take(a.up, a);
+      }
+    // Coefficients of the touched pairs (each depends on its own statistics only), in pair order for locality
+    // (this and the weight refold that follows): where most of the bucket was touched, by a scan of its flags.
+    if (touched.size() * 16 > span) {
+      touched.clear();
+      for (size_t i = lo, e = std::min(n, size_t(lo) + span); i < e; i++)
+        if (mb.seen[i]) touched.push_back(int(i));
+    }
+    for (int i : touched) {
+      update_coeffs(s, size_t(i), p);
+      mb.seen[size_t(i)] = 0;
+    }
+  });
+  std::vector<int> out;
+  size_t total = 0;
+  for (size_t b = 0; b < buckets; b++) total += mb.touched[b].size();
+  out.reserve(total);
+  for (size_t b = 0; b < buckets; b++) out.insert(out.end(), mb.touched[b].begin(), mb.touched[b].end());
+  return out;
 }
 
 double posterior_weight(const bayes_params& p, double bound, double scale, double d, double n0, double n1,

@@ -35,6 +35,9 @@ struct bayes_params {
                                  // regression) and drops clusters behind its surface; false (ablation): mu0 from the
                                  // bound at every shading point, which then evaluates full cone bounds per cluster
   double cv_min_visible = 0.98;  // control variates only for pairs with E[1 - p0] at least this
+  double refold_tolerance = 0.05;  // hierarchy: a coarse pair's children are refolded when its p1 has moved by more
+                                   // than this fraction (of max(p1, 0.1)) since their last fold (a child's p1 moves
+                                   // by at most that fraction too); 0: whenever it changes at all
   bool control_variate = true;   // region prior only: where NEE is unweighted (direct illumination, the last path
                                  // vertex), add the learned mean c_j = E[1 - p0] k_j / d^2 of every cluster and
                                  // estimate the residual (Y_J - c_J) / P_J, with P_j proportional to the root of the
@@ -61,13 +64,27 @@ struct pair_weight {
 // Region-prior mode (bayes_params::region_prior): observations are recorded as z = (Y / s) d^2 with s = albedo / pi
 // of the shading point (an irradiance times d^2, free of the surface's albedo), mu0 is fixed per pair when its region
 // is created, and the weight at a point is w = W g with W = sqrt(p1 max(w2 mu0^2 + w1 mu0 + w0, wc mu0^2)) per pair.
+// A pair's sufficient statistics: counts of zero and non-zero samples, mean and sum of squared deviations of the
+// non-zero ones. One 32-byte record per pair: the fold between passes touches one cache line per update.
+struct pair_moments {
+  double n0 = 0, n1 = 0, mean = 0, m2 = 0;
+};
+
+// Scratch of merge_rows, kept between passes so that a pass allocates nothing once capacities have settled.
+struct merge_buffers {
+  std::vector<std::vector<int>> touched;       // per bucket: the pairs it updated
+  std::vector<uint8_t> seen;                   // per pair: already in a touched list (all zero between calls)
+};
+
 struct bayes_stats {
-  std::vector<double> n0, n1, mean, m2;  // statistics: read and written between passes only
+  std::vector<pair_moments> m;           // statistics: read and written between passes only
   std::vector<pair_coeffs> coeffs;       // posterior per pair without the hierarchy (between passes only)
   std::vector<pair_weight> weight;       // read by every shading point (point-prior mode)
   std::vector<float> mu0;                // region-prior mode: the pair's prior mean of z (set with its region)
   std::vector<float> w;                  // region-prior mode: W per pair (+ 4 padding entries for SSE loads)
   std::vector<float> w_cv, cv;           // control variates: W of the residual, and E[1 - p0] k (+ 4 padding each)
+  std::vector<float> p1_folded;          // per pair: its p1 when its children's weights were last folded (hierarchy)
+  merge_buffers scratch;
 };
 
 // The posterior point estimates of pair i for prior mean mu0: k (mean of z) and h (variance of z); false when the
@@ -84,17 +101,18 @@ void decay_stats(bayes_stats& s, double gamma, const bayes_params& p);
 // E[1 - p0] of pair i, under the hierarchical prior when `up` (its parent pair) is valid.
 inline double pair_p1(const bayes_stats& s, size_t i, int up, const bayes_params& p) {
   if (up < 0 || !(p.hierarchy > 0) || !p.prior) return s.coeffs[i].p1;
-  return (p.hierarchy * double(s.coeffs[size_t(up)].p1) + s.n1[i]) / (p.hierarchy + s.n0[i] + s.n1[i]);
+  return (p.hierarchy * double(s.coeffs[size_t(up)].p1) + s.m[i].n1) / (p.hierarchy + s.m[i].n0 + s.m[i].n1);
 }
 // Folds pair i's p1 into its sampling weight.
 inline double eval_weight(const pair_weight& h, const bayes_params& p, double v, double g);
 inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
   double p1 = pair_p1(s, i, up, p);
   const pair_coeffs& c = s.coeffs[i];
-  s.weight[i] = {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
-  // With v = mu0 g the weight is g times its value at g = 1 (see pair_coeffs): W = eval_weight(v = mu0, g = 1).
+  pair_weight pw = {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
+  s.weight[i] = pw;  // read by every shading point in point-prior mode (and by the tests)
   if (!p.region_prior) return;
-  s.w[i] = float(eval_weight(s.weight[i], p, s.mu0[i], 1.0));
+  // With v = mu0 g the weight is g times its value at g = 1 (see pair_coeffs): W = eval_weight(v = mu0, g = 1).
+  s.w[i] = float(eval_weight(pw, p, s.mu0[i], 1.0));
   if (!p.control_variate) return;
   double k, h;
   // Only for clusters the region nearly always sees: where visibility is mixed it is usually a function of
@@ -122,6 +140,7 @@ inline double eval_weight(const pair_weight& h, const bayes_params& p, double v,
 // One pair's statistics accumulated within one image row (Welford).
 struct pair_accum {
   int pair;
+  int up;  // the pair's parent (set by merge_rows)
   double n0, n1, mean, m2;
 };
 
@@ -137,10 +156,10 @@ struct bayes_row {
 
 // Folds the rows, in order, into the statistics (Chan's parallel update) — each accumulator into its pair and
 // into that pair's parent (`parents` = region_state::pair_parent, or nullptr for none) — and refreshes the
-// coefficients of the pairs touched. Weights are not refolded (see fold_weight). Returns the touched pairs
-// flagged in a per-pair byte column.
-std::vector<uint8_t> merge_rows(bayes_stats& s, const std::vector<bayes_row>& rows, const bayes_params& p,
-                                const std::vector<int>* parents);
+// coefficients of the pairs touched. Weights are not refolded (see fold_weight). Returns the touched pairs (each
+// once, in an order fixed by the rows). Work and memory scale with the rows' accumulators, not with the pairs.
+std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const bayes_params& p,
+                            const std::vector<int>* parents);
 
 // Reference form of the weight (the conjugate posterior written out, in double): sqrt((1 - p0)(k^2 + h)) / d^2
 // (or the ablations) from a pair's statistics and mu0 = scale * bound * d^2. eval_weight must agree with it.

@@ -13,6 +13,7 @@ namespace bl {
 // The bound sampler; owns its regions, reads a light tree it does not own.
 struct bound_sampler {
   static constexpr bool learns = true;
+  static constexpr int rows_per_state = 1;  // image rows per region-request state
   using context = cut_context;
   using row_state = region_requests;
   const light_tree_data* tree = nullptr;

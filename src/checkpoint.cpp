@@ -6,6 +6,7 @@
 #include "errors.h"
 #include "rng.h"
 
+#include <cmath>
 #include <cstring>
 #include <type_traits>
 
@@ -14,7 +15,7 @@ namespace bl {
 namespace {
 
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
-constexpr uint32_t version = 1;
+constexpr uint32_t version = 2;  // 2: pass schedule and lazy refold changed (a resume would not match)
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -116,14 +117,27 @@ void read_regions(reader& r, region_state& s) {
   rebuild_region_table(s);
 }
 
+// Field f of a pair's statistics: n0, n1, mean, m2.
+double& moment_field(pair_moments& m, int f) { return f == 0 ? m.n0 : f == 1 ? m.n1 : f == 2 ? m.mean : m.m2; }
+double moment_field(const pair_moments& m, int f) { return f == 0 ? m.n0 : f == 1 ? m.n1 : f == 2 ? m.mean : m.m2; }
+
 void write_sampler(writer& w, const light_sampler& ls) {
   if (auto* b = std::get_if<bound_sampler>(&ls)) write_regions(w, b->regions);
   if (auto* b = std::get_if<bayes_sampler>(&ls)) {
     write_regions(w, b->regions);
-    w.column(b->stats.n0);
-    w.column(b->stats.n1);
-    w.column(b->stats.mean);
-    w.column(b->stats.m2);
+    // Four columns (n0, n1, mean, m2), as the statistics were laid out when the format was fixed.
+    std::vector<double> col(b->stats.m.size());
+    for (int f = 0; f < 4; f++) {
+      for (size_t i = 0; i < col.size(); i++) col[i] = moment_field(b->stats.m[i], f);
+      w.column(col);
+    }
+    // The sampling weights are folded lazily (a pair's children only when its p1 moved by more than a tolerance),
+    // so they depend on the history, not only on the statistics: saved as they are.
+    w.column(b->stats.weight);
+    w.column(b->stats.w);
+    w.column(b->stats.w_cv);
+    w.column(b->stats.cv);
+    w.column(b->stats.p1_folded);
     w.value(uint8_t(b->frozen));
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
@@ -140,14 +154,31 @@ void read_sampler(reader& r, light_sampler& ls) {
   if (auto* b = std::get_if<bayes_sampler>(&ls)) {
     read_regions(r, b->regions);
     size_t pairs = size_t(b->regions.pairs);
-    b->stats.n0 = r.column<double>(pairs);
-    b->stats.n1 = r.column<double>(pairs);
-    b->stats.mean = r.column<double>(pairs);
-    b->stats.m2 = r.column<double>(pairs);
+    b->stats.m.assign(pairs, pair_moments{});
+    for (int f = 0; f < 4; f++) {
+      std::vector<double> col = r.column<double>(pairs);
+      for (size_t i = 0; i < pairs; i++) moment_field(b->stats.m[i], f) = col[i];
+    }
+    std::vector<pair_weight> weight = r.column<pair_weight>(pairs);
+    std::vector<float> wcol = r.column<float>(pairs + 4), w_cv = r.column<float>(pairs + 4),
+                       cv = r.column<float>(pairs + 4), p1_folded = r.column<float>(pairs);
+    auto valid = [](float x) { return std::isfinite(x) && x >= 0; };
+    for (const std::vector<float>* c : {&wcol, &w_cv, &p1_folded})
+      for (float x : *c)
+        if (!valid(x)) r.fail("sampling weights");
+    for (float x : cv)
+      if (!std::isfinite(x)) r.fail("sampling weights");
+    for (const pair_weight& x : weight)
+      if (!std::isfinite(x.w2) || !std::isfinite(x.w1) || !std::isfinite(x.w0) || !std::isfinite(x.wc)) r.fail("sampling weights");
     b->frozen = r.value<uint8_t>() != 0;
-    // Prior means, coefficients and weights are functions of the regions and statistics: recompute them (bit for
-    // bit the same).
+    // Prior means and coefficients are functions of the regions and statistics: recomputed (bit for bit the same);
+    // then the saved weights replace the recomputed ones.
     b->rebuild_posterior();
+    b->stats.weight = std::move(weight);
+    b->stats.w = std::move(wcol);
+    b->stats.w_cv = std::move(w_cv);
+    b->stats.cv = std::move(cv);
+    b->stats.p1_folded = std::move(p1_folded);
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
     read_regions(r, d->deeper.regions);

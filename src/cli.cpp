@@ -328,7 +328,8 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--checkpoint-every", o.checkpoint_every, "Seconds between checkpoints (default 30; 0: every pass)")
       ->check(CLI::Range(0.0, 1e9));
   r->add_option("--resume", o.resume,
-                "Continue the render saved in FILE (same scene and options; --spp may be larger)");
+                "Continue the render saved in FILE (same scene and options; --spp may be larger: the same bytes as one render "
+                "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...)");
   r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes")
       ->group("");
   r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")

@@ -32,6 +32,7 @@ struct donikian_row {
 // The Donikian sampler; owns its estimates and a bound sampler for deeper vertices.
 struct donikian_sampler {
   static constexpr bool learns = true;
+  static constexpr int rows_per_state = 1;  // a row state holds one image row's pixel estimates
   using context = cut_context;
   using row_state = donikian_row;
   const light_tree_data* tree = nullptr;

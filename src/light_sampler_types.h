@@ -9,7 +9,9 @@
 //   void end_pass()                                  between passes (non-learning samplers)
 //   void begin_frame(double decay)                   animations: scale learned statistics by `decay` (else no-op)
 //   static constexpr bool learns; learners also have S::row_state, record(row_state&, const nee_event&)
-//   and learn(std::vector<row_state>&) called between passes with the rows in image order.
+//   and learn(std::vector<row_state>&) called between passes with the rows in image order; S::rows_per_state
+//   consecutive image rows (a band) share one row_state, filled in pixel order.
+//   Learners may have `learn_timing timing` (seconds per part of learn, summed over passes) for profiles.
 // Invariant (unbiasedness): every light that can contribute at a point has pmf > 0 there.
 #pragma once
 
@@ -29,6 +31,13 @@ bool parse_sampler_kind(const std::string& name, sampler_kind& kind);
 std::string sampler_names();
 // Whether a sampler kind is implemented in this build.
 bool sampler_available(sampler_kind kind);
+
+// Wall seconds of the parts of learning between passes, summed over passes.
+struct learn_timing {
+  double reduce = 0;   // folding the passes' observation records into the statistics (and their coefficients)
+  double regions = 0;  // creating requested regions, their cuts and prior means
+  double refold = 0;   // folding the posterior into the sampling weights of the pairs that changed
+};
 
 // What light selection sees of a shading point.
 struct shade_point {

@@ -147,6 +147,15 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
   line("  %-44s %10.1f %7.1f%%\n", "film, scheduling and timer overhead", rest / nee * 1e9, 100 * rest / b.seconds);
   line("  %-44s %10.1f %7.1f%%\n", "between passes: reduction + PMF rebuild", b.learn_seconds / nee * 1e9,
        100 * b.learn_seconds / b.seconds);
+  const learn_timing& lp = b.learn_parts;
+  if (lp.reduce + lp.regions + lp.refold > 0) {
+    line("  %-44s %10.1f %7.1f%%\n", "  of which: fold of observation records", lp.reduce / nee * 1e9,
+         100 * lp.reduce / b.seconds);
+    line("  %-44s %10.1f %7.1f%%\n", "  of which: new regions (cuts, prior means)", lp.regions / nee * 1e9,
+         100 * lp.regions / b.seconds);
+    line("  %-44s %10.1f %7.1f%%\n", "  of which: refold of changed weights", lp.refold / nee * 1e9,
+         100 * lp.refold / b.seconds);
+  }
   line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee * 1e9, 100.0);
   line("\n  raw Embree rtcOccluded1 on this scene: %.2f M rays/s (%zu rays, %d threads)\n", limit * 1e-6,
        rays.org.size(), threads);

@@ -63,6 +63,7 @@ struct render_result {
   double setup_seconds = 0;   // light tree, regions (before the first pass; not in `seconds`)
   size_t sampler_bytes = 0;   // memory of the sampler's regions, cuts and statistics
   double learn_seconds = 0;   // of `seconds`: learning between passes (the reduction and PMF rebuild)
+  learn_timing learn_parts;   // learn_seconds by part, where the sampler reports them (bayes)
   uint64_t profile_cycles[prof_count] = {};  // time-stamp counter cycles per stage (profile renders only)
   int regions = 0;            // regions of a region-based sampler
   int64_t pairs = 0;          // (region, cluster) pairs

@@ -303,13 +303,13 @@ TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes
         double v = scale * bound, g = 1 / (d * d);
         double fast = eval_weight(s.weight[size_t(i)], p, v, g);
         double ref =
-            posterior_weight(p, bound, scale, d, s.n0[size_t(i)], s.n1[size_t(i)], s.mean[size_t(i)], s.m2[size_t(i)]);
+            posterior_weight(p, bound, scale, d, s.m[size_t(i)].n0, s.m[size_t(i)].n1, s.m[size_t(i)].mean, s.m[size_t(i)].m2);
         double e = ref == 0 ? std::fabs(fast) : rel_err(fast, ref);
         if (e > worst) worst = e, worst_pair = i;
       }
     INFO("prior " << p.prior << " second moment " << p.second_moment << " alpha0 " << p.alpha0 << ": worst pair "
-                  << worst_pair << " n0 " << s.n0[size_t(worst_pair)] << " n1 " << s.n1[size_t(worst_pair)] << " mean "
-                  << s.mean[size_t(worst_pair)] << " m2 " << s.m2[size_t(worst_pair)]);
+                  << worst_pair << " n0 " << s.m[size_t(worst_pair)].n0 << " n1 " << s.m[size_t(worst_pair)].n1 << " mean "
+                  << s.m[size_t(worst_pair)].mean << " m2 " << s.m[size_t(worst_pair)].m2);
     CHECK(worst < 1e-5);
   }
 }
@@ -498,15 +498,15 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
     for (int i = 0; i < pairs; i++) {
       INFO("grouping " << grouping << " pair " << i);
       moments ex = exact_moments(obs[size_t(i)]);
-      CHECK(s.n0[size_t(i)] == ex.n0);
-      CHECK(s.n1[size_t(i)] == ex.n1);
-      CHECK(rel_err(s.mean[size_t(i)], welford[size_t(i)].mean) <= 1e-12);
-      CHECK(rel_err(s.m2[size_t(i)], welford[size_t(i)].m2) <= 1e-12);
-      CHECK(rel_err(s.mean[size_t(i)], ex.mean) <= 1e-12);
-      CHECK(rel_err(s.m2[size_t(i)], ex.m2) <= 1e-12);
+      CHECK(s.m[size_t(i)].n0 == ex.n0);
+      CHECK(s.m[size_t(i)].n1 == ex.n1);
+      CHECK(rel_err(s.m[size_t(i)].mean, welford[size_t(i)].mean) <= 1e-12);
+      CHECK(rel_err(s.m[size_t(i)].m2, welford[size_t(i)].m2) <= 1e-12);
+      CHECK(rel_err(s.m[size_t(i)].mean, ex.mean) <= 1e-12);
+      CHECK(rel_err(s.m[size_t(i)].m2, ex.m2) <= 1e-12);
       // The coefficients were refreshed from the merged statistics.
       double ref =
-          posterior_weight(p, 2.0, 0.3, 1.5, s.n0[size_t(i)], s.n1[size_t(i)], s.mean[size_t(i)], s.m2[size_t(i)]);
+          posterior_weight(p, 2.0, 0.3, 1.5, s.m[size_t(i)].n0, s.m[size_t(i)].n1, s.m[size_t(i)].mean, s.m[size_t(i)].m2);
       CHECK(rel_err(eval_weight(s.weight[size_t(i)], p, 0.6, 1 / 2.25), ref) < 1e-5);
     }
   }
@@ -520,13 +520,13 @@ TEST_CASE("decaying statistics scales the counts and keeps the mean", "[bayes]")
   for (double z : {0.0, 1.0, 2.0, 0.0, 4.0}) rows[0].add(1, z);
   merge_rows(s, rows, p, nullptr);
   refresh_weights(s, nullptr, p);
-  double mean = s.mean[1], m2 = s.m2[1];
+  double mean = s.m[1].mean, m2 = s.m[1].m2;
   decay_stats(s, 0.5, p);
   refresh_weights(s, nullptr, p);
-  CHECK(s.n0[1] == 1.0);
-  CHECK(s.n1[1] == 1.5);
-  CHECK(s.mean[1] == mean);
-  CHECK(s.m2[1] == 0.5 * m2);
+  CHECK(s.m[1].n0 == 1.0);
+  CHECK(s.m[1].n1 == 1.5);
+  CHECK(s.m[1].mean == mean);
+  CHECK(s.m[1].m2 == 0.5 * m2);
   CHECK(rel_err(eval_weight(s.weight[1], p, 0.2, 0.5),
                 posterior_weight(p, 0.2, 1.0, std::sqrt(2.0), 1.0, 1.5, mean, 0.5 * m2)) < 1e-5);
 }
@@ -603,7 +603,7 @@ convergence_result run_convergence(const bayes_params& params, const convergence
   }
   for (int j = 0; j < 3; j++)
     r.mean_error =
-        std::max(r.mean_error, rel_err(s.stats.mean[base + size_t(j)], double(zsum[size_t(j)] / zcount[size_t(j)])));
+        std::max(r.mean_error, rel_err(s.stats.m[base + size_t(j)].mean, double(zsum[size_t(j)] / zcount[size_t(j)])));
   s.prepare(*ctx, pt);
   double total = 0, sigma = 0, bias = 0;
   for (int j = 0; j < 3; j++) {
@@ -779,10 +779,10 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
       size_t i = base + size_t(j);
       int up = s.regions.pair_parent[i];
       REQUIRE(up == s.regions.pair_offset[size_t(coarse)] + j);
-      CHECK(s.stats.n0[size_t(up)] == s.stats.n0[i]);
-      CHECK(s.stats.n1[size_t(up)] == s.stats.n1[i]);
-      CHECK(s.stats.mean[size_t(up)] == s.stats.mean[i]);
-      CHECK(s.stats.m2[size_t(up)] == s.stats.m2[i]);
+      CHECK(s.stats.m[size_t(up)].n0 == s.stats.m[i].n0);
+      CHECK(s.stats.m[size_t(up)].n1 == s.stats.m[i].n1);
+      CHECK(s.stats.m[size_t(up)].mean == s.stats.m[i].mean);
+      CHECK(s.stats.m[size_t(up)].m2 == s.stats.m[i].m2);
     }
     // More observations of cluster 0 reach only the parent: its posterior now differs from the fine pair's.
     std::vector<bayes_row> more(1);
@@ -794,15 +794,15 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     for (int j = 0; j < 3; j++) {
       size_t i = base + size_t(j), up = size_t(s.regions.pair_parent[i]);
       prior_args a = prior_of(*t, s, *ctx, j, pt);
-      double wf = posterior_weight(s.params, a.bound, a.scale, a.d, s.stats.n0[i], s.stats.n1[i], s.stats.mean[i],
-                                   s.stats.m2[i]);
-      double wp = posterior_weight(s.params, a.bound, a.scale, a.d, s.stats.n0[up], s.stats.n1[up], s.stats.mean[up],
-                                   s.stats.m2[up]);
+      double wf = posterior_weight(s.params, a.bound, a.scale, a.d, s.stats.m[i].n0, s.stats.m[i].n1, s.stats.m[i].mean,
+                                   s.stats.m[i].m2);
+      double wp = posterior_weight(s.params, a.bound, a.scale, a.d, s.stats.m[up].n0, s.stats.m[up].n1, s.stats.m[up].mean,
+                                   s.stats.m[up].m2);
       const bayes_params& bp = s.params;
-      double n = s.stats.n0[i] + s.stats.n1[i], np = s.stats.n0[up] + s.stats.n1[up];
-      double p1_own = (bp.b0 + s.stats.n1[i]) / (bp.a0 + bp.b0 + n);
-      double p1_parent = (bp.b0 + s.stats.n1[up]) / (bp.a0 + bp.b0 + np);
-      double p1_h = (bp.hierarchy * p1_parent + s.stats.n1[i]) / (bp.hierarchy + n);
+      double n = s.stats.m[i].n0 + s.stats.m[i].n1, np = s.stats.m[up].n0 + s.stats.m[up].n1;
+      double p1_own = (bp.b0 + s.stats.m[i].n1) / (bp.a0 + bp.b0 + n);
+      double p1_parent = (bp.b0 + s.stats.m[up].n1) / (bp.a0 + bp.b0 + np);
+      double p1_h = (bp.hierarchy * p1_parent + s.stats.m[i].n1) / (bp.hierarchy + n);
       w[j] = second_moment ? wf * std::sqrt(p1_h / p1_own) : wf * (p1_h / p1_own);
       own[j] = wf;
       (void)wp;

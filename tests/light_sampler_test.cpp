@@ -386,9 +386,9 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
           // The statistics did learn something (and stayed finite).
           double n = 0;
           bool finite = true;
-          for (size_t i = 0; i < b->stats.n0.size(); i++) {
-            n += b->stats.n0[i] + b->stats.n1[i];
-            finite = finite && std::isfinite(b->stats.mean[i]) && std::isfinite(b->stats.m2[i]) &&
+          for (size_t i = 0; i < b->stats.m.size(); i++) {
+            n += b->stats.m[i].n0 + b->stats.m[i].n1;
+            finite = finite && std::isfinite(b->stats.m[i].mean) && std::isfinite(b->stats.m[i].m2) &&
                      std::isfinite(b->stats.weight[i].w2) && std::isfinite(b->stats.weight[i].w1) &&
                      std::isfinite(b->stats.weight[i].w0) && std::isfinite(b->stats.weight[i].wc) &&
                      std::isfinite(b->stats.coeffs[i].p1);
@@ -398,6 +398,39 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
         }
       }
     }
+  }
+}
+
+TEST_CASE("lazily refolded bayes weights stay within the refold tolerance of an exact refold", "[samplers][bayes]") {
+  auto t = make_test_scene(false);
+  for (double tol : {0.0, 0.05, 0.2}) {
+    sampler_params sp;
+    sp.kind = sampler_kind::bayes;
+    sp.bayes.refold_tolerance = tol;
+    light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+    auto& s = std::get<bayes_sampler>(ls);
+    learn_passes(t->in, s, 12);
+    bayes_stats exact = s.stats;
+    refresh_weights(exact, &s.regions.pair_parent, s.params);
+    int checked = 0, differ = 0;
+    double worst = 0;
+    for (size_t i = 0; i < s.stats.m.size(); i++) {
+      int up = s.regions.pair_parent[i];
+      if (up == invalid_id) {
+        CHECK(s.stats.w[i] == exact.w[i]);  // no parent: always folded exactly
+        continue;
+      }
+      if (exact.coeffs[size_t(up)].p1 < 0.1f || !(exact.w[i] > 0)) continue;
+      checked++;
+      differ += s.stats.w[i] != exact.w[i];
+      worst = std::max(worst, std::fabs(double(s.stats.w[i]) / double(exact.w[i]) - 1));
+    }
+    INFO("tolerance " << tol << ": " << checked << " fine pairs, " << differ << " lazily stale, worst " << worst);
+    CHECK(checked > 100);
+    if (tol == 0) CHECK(differ == 0);
+    // W is proportional to sqrt(p1), and a child's p1 is at most 2 tol (relative) from its exact value.
+    CHECK(worst <= std::sqrt(1 + 2 * tol) - 1 + 1e-5);
+    if (tol >= 0.2) CHECK(differ > 0);  // the laziness is real: some weights were not refolded
   }
 }
 

@@ -103,16 +103,16 @@ void check_bayes_state(const built_scene& b, int depth) {
   CHECK(st.bad_samples == 0);
   double observations = 0;
   size_t bad = 0;
-  for (size_t i = 0; i < s.stats.n0.size(); i++) {
-    observations += s.stats.n0[i] + s.stats.n1[i];
-    bool ok = std::isfinite(s.stats.n0[i]) && std::isfinite(s.stats.n1[i]) && std::isfinite(s.stats.mean[i]) &&
-              std::isfinite(s.stats.m2[i]) && s.stats.m2[i] >= 0 && s.stats.mean[i] >= 0 &&
+  for (size_t i = 0; i < s.stats.m.size(); i++) {
+    observations += s.stats.m[i].n0 + s.stats.m[i].n1;
+    bool ok = std::isfinite(s.stats.m[i].n0) && std::isfinite(s.stats.m[i].n1) && std::isfinite(s.stats.m[i].mean) &&
+              std::isfinite(s.stats.m[i].m2) && s.stats.m[i].m2 >= 0 && s.stats.m[i].mean >= 0 &&
               std::isfinite(s.stats.weight[i].w2) && std::isfinite(s.stats.weight[i].w1) &&
                      std::isfinite(s.stats.weight[i].w0) && std::isfinite(s.stats.weight[i].wc) &&
                      std::isfinite(s.stats.coeffs[i].p1);
     if (!ok) bad++;
   }
-  INFO("pairs " << s.stats.n0.size() << " observations " << observations);
+  INFO("pairs " << s.stats.m.size() << " observations " << observations);
   CHECK(bad == 0);
   CHECK(observations > 0);
   // Every learned pmf is finite at the camera's first hits.
