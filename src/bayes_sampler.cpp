@@ -133,8 +133,12 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
       if (ctx.cvg[j] != 0) sum += cluster_color(ctx, j) * ctx.cvg[j];
     ctx.cv_sum = sum;
   }
-  double w[max_cut_entries];
-  for (int j = 0; j < ctx.count; j++) w[j] = wf[j];
+  alignas(16) double w[max_cut_entries + 3];
+  for (int j = 0; j < ctx.count; j += 4) {  // to double, four at a time (wf has room for the padding lanes)
+    __m128 x = _mm_load_ps(wf + j);
+    _mm_store_pd(w + j, _mm_cvtps_pd(x));
+    _mm_store_pd(w + j + 2, _mm_cvtps_pd(_mm_movehl_ps(x, x)));
+  }
   // Defensive mixing with the prior-only pmf (mu0 g: the region's bound model; always a little for the naive
   // ablation, which can starve clusters).
   double eps = params.prior ? params.epsilon : std::max(params.epsilon, 1e-3);

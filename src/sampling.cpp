@@ -1,31 +1,84 @@
 // sampling: discrete distributions (the rest of the warps are inline in the header).
 #include "sampling.h"
 
+#include <emmintrin.h>
+
 #include <algorithm>
 
 namespace bl {
 
+namespace {
+
+// max(w, floor) where w > 0, else 0 (NaN included), without a branch.
+inline double floored(double w, double floor) {
+  __m128d x = _mm_set_sd(w);
+  __m128d positive = _mm_cmpgt_sd(x, _mm_setzero_pd());
+  return _mm_cvtsd_f64(_mm_and_pd(_mm_max_sd(x, _mm_set_sd(floor)), positive));
+}
+
+}  // namespace
+
 bool fill_cdf(const double* w, int n, double* cdf) {
-  double total = 0;
-  for (int i = 0; i < n; i++) total += w[i] > 0 ? w[i] : 0.0;
+  // Sums run as four interleaved chains (instruction-level parallelism; a fixed order, so deterministic): the total
+  // over four lanes, and the running sums over the array's four quarters, each quarter then shifted by the sum of
+  // the quarters before it. Shifted boundaries agree bit for bit (the same addition), so cdf is non-decreasing and
+  // an item of weight zero keeps probability exactly zero.
+  double lane[4] = {0, 0, 0, 0};
+  int i = 0;
+  for (; i + 4 <= n; i += 4)
+    for (int l = 0; l < 4; l++) lane[l] += std::max(0.0, w[i + l]);  // maxsd: NaN and negatives give 0
+  for (; i < n; i++) lane[0] += std::max(0.0, w[i]);
+  double total = (lane[0] + lane[1]) + (lane[2] + lane[3]);
   cdf[0] = 0;
   if (!(total > 0) || !std::isfinite(total)) {
-    for (int i = 0; i < n; i++) cdf[i + 1] = 0;
+    for (int k = 0; k < n; k++) cdf[k + 1] = 0;
     return false;
   }
   // Floor every positive weight so that no item that can contribute rounds to probability zero (written without
   // branches: zero weights come in unpredictable patterns).
-  double floor = total * min_positive_share, acc = 0;
-  int last = -1;
-  for (int i = 0; i < n; i++) {
-    bool positive = w[i] > 0;
-    acc += positive ? std::max(w[i], floor) : 0.0;
-    last = positive ? i : last;
-    cdf[i + 1] = acc;
+  const double floor = total * min_positive_share;
+  const int q = (n + 3) / 4;
+  double off[4] = {0, 0, 0, 0};
+  int starts[5];
+  if (n >= 9) {
+    // Quarters [0, q), [q, 2q), [2q, 3q) are full (3q <= n for n >= 9), the last one holds the rest.
+    const int tail = n - 3 * q;
+    double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+    const double* w1 = w + q;
+    const double* w2 = w + 2 * q;
+    const double* w3 = w + 3 * q;
+    double* c0 = cdf + 1;
+    double* c1 = cdf + 1 + q;
+    double* c2 = cdf + 1 + 2 * q;
+    double* c3 = cdf + 1 + 3 * q;
+    for (int k = 0; k < tail; k++) {
+      c0[k] = a0 += floored(w[k], floor);
+      c1[k] = a1 += floored(w1[k], floor);
+      c2[k] = a2 += floored(w2[k], floor);
+      c3[k] = a3 += floored(w3[k], floor);
+    }
+    for (int k = tail; k < q; k++) {
+      c0[k] = a0 += floored(w[k], floor);
+      c1[k] = a1 += floored(w1[k], floor);
+      c2[k] = a2 += floored(w2[k], floor);
+    }
+    off[1] = a0;
+    off[2] = a1 + off[1];
+    off[3] = a2 + off[2];
+    total = a3 + off[3];
+    starts[0] = 0, starts[1] = q, starts[2] = 2 * q, starts[3] = 3 * q, starts[4] = n;
+  } else {
+    double a = 0;
+    for (int k = 0; k < n; k++) cdf[k + 1] = a += floored(w[k], floor);
+    total = a;
+    starts[0] = 0, starts[1] = starts[2] = starts[3] = starts[4] = n;
   }
-  double inv = 1 / acc;
-  for (int i = 0; i < n; i++) cdf[i + 1] *= inv;
-  for (int i = last; i < n; i++) cdf[i + 1] = 1.0;  // exact end point
+  const double inv = 1 / total;
+  for (int l = 0; l < 4; l++)
+    for (int j = starts[l]; j < starts[l + 1]; j++) cdf[j + 1] = (cdf[j + 1] + off[l]) * inv;
+  int last = n - 1;
+  while (last >= 0 && !(w[last] > 0)) last--;
+  for (int k = last; k < n; k++) cdf[k + 1] = 1.0;  // exact end point
   return true;
 }
 
