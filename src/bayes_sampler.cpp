@@ -268,7 +268,7 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
   tbb::parallel_for(tbb::blocked_range<size_t>(old_pairs, pairs, 1024), [&](const tbb::blocked_range<size_t>& g) {
     for (size_t i = g.begin(); i < g.end(); i++) {
       fold(i);
-      stats.p1_folded[i] = stats.coeffs[i].p1;
+      if (regions.pair_parent[i] == invalid_id) stats.p1_folded[i] = stats.coeffs[i].p1;
     }
   });
   if (!hier) return;
@@ -290,9 +290,14 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
     moved.push_back(i);
     stats.p1_folded[k] = now;
   }
+  // A child is refolded when its own p1 moved by more than the tolerance from the one its weight holds (a child
+  // with many samples of its own barely follows its parent).
   tbb::parallel_for(tbb::blocked_range<size_t>(0, moved.size(), 16), [&](const tbb::blocked_range<size_t>& g) {
     for (size_t m = g.begin(); m < g.end(); m++)
-      for (int c = first_child[size_t(moved[m])]; c != invalid_id; c = next_sibling[size_t(c)]) fold(size_t(c));
+      for (int c = first_child[size_t(moved[m])]; c != invalid_id; c = next_sibling[size_t(c)]) {
+        double now = pair_p1(stats, size_t(c), moved[m], params), then = stats.p1_folded[size_t(c)];
+        if (std::fabs(now - then) > tol * std::max(then, p1_floor)) fold(size_t(c));
+      }
   });
 }
 

@@ -141,8 +141,9 @@ void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const baye
   // Every pair independently (the result does not depend on how the range is split).
   tbb::parallel_for(tbb::blocked_range<size_t>(0, s.weight.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); i++) {
-      fold_weight(s, i, parents ? (*parents)[i] : invalid_id, p);
-      s.p1_folded[i] = s.coeffs[i].p1;
+      int up = parents ? (*parents)[i] : invalid_id;
+      fold_weight(s, i, up, p);
+      if (up < 0) s.p1_folded[i] = s.coeffs[i].p1;
     }
   });
 }
@@ -162,32 +163,48 @@ static void merge_accum(pair_moments& m, const pair_accum& a) {
 std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const bayes_params& p,
                             const std::vector<int>* parents) {
   // Each accumulator updates its pair and that pair's parent. The updates of one pair must happen in row order (the
-  // order fixes the floating-point result). Buckets (disjoint pair ranges) fold in parallel, each scanning every
-  // row in order and taking the updates of its own pairs: bit for bit the sequential fold for any number of buckets,
-  // so the count may follow the thread count. No per-update lists: a scan costs a few ns per accumulator.
+  // order fixes the floating-point result). Buckets (disjoint pair ranges) fold in parallel, each taking its updates
+  // row by row in order: bit for bit the sequential fold for any number of buckets, so the count may follow the
+  // thread count. Work: a few passes over the rows' accumulators, nothing per pair.
   size_t n = s.m.size();
   merge_buffers& mb = s.scratch;
-  tbb::parallel_for(size_t(0), rows.size(), [&](size_t r) {
-    for (pair_accum& a : rows[r].acc) a.up = parents ? (*parents)[size_t(a.pair)] : invalid_id;
-  });
   const size_t buckets = std::clamp<size_t>(4 * size_t(tbb::this_task_arena::max_concurrency()), 1, 256);
   const size_t span = std::max<size_t>(1, (n + buckets - 1) / buckets);
+  // Per row, in parallel: the parents, and the row's updates sorted by bucket (a counting sort that keeps their
+  // order within each bucket).
+  tbb::parallel_for(size_t(0), rows.size(), [&](size_t r) {
+    bayes_row& row = rows[r];
+    row.start.assign(buckets + 1, 0);
+    for (pair_accum& a : row.acc) {
+      a.up = parents ? (*parents)[size_t(a.pair)] : invalid_id;
+      row.start[size_t(a.pair) / span + 1]++;
+      if (a.up != invalid_id) row.start[size_t(a.up) / span + 1]++;
+    }
+    for (size_t b = 0; b < buckets; b++) row.start[b + 1] += row.start[b];
+    row.order.resize(row.start[buckets]);
+    uint32_t* pos = row.start.data();  // advanced while filling, then restored below
+    for (size_t k = 0; k < row.acc.size(); k++) {
+      const pair_accum& a = row.acc[k];
+      row.order[pos[size_t(a.pair) / span]++] = uint32_t(2 * k);
+      if (a.up != invalid_id) row.order[pos[size_t(a.up) / span]++] = uint32_t(2 * k + 1);
+    }
+    for (size_t b = buckets; b > 0; b--) row.start[b] = row.start[b - 1];  // pos[b] ended at the next start
+    row.start[0] = 0;
+  });
   mb.touched.resize(buckets);
   if (mb.seen.size() < n) mb.seen.resize(n, 0);
   tbb::parallel_for(size_t(0), buckets, [&](size_t b) {
     std::vector<int>& touched = mb.touched[b];
     touched.clear();
-    const unsigned lo = unsigned(b * span), len = unsigned(span);
-    auto take = [&](int pair, const pair_accum& a) {
-      if (unsigned(pair) - lo >= len) return;  // another bucket's (invalid_id wraps to a huge value)
-      merge_accum(s.m[size_t(pair)], a);
-      uint8_t& seen = mb.seen[size_t(pair)];
-      if (!seen) seen = 1, touched.push_back(pair);
-    };
+    const size_t lo = b * span;
     for (const bayes_row& row : rows)
-      for (const pair_accum& a : row.acc) {
-        take(a.pair, a);
-        take(a.up, a);
+      for (uint32_t k = row.start[b], e = row.start[b + 1]; k < e; k++) {
+        uint32_t t = row.order[k];
+        const pair_accum& a = row.acc[t >> 1];
+        int pair = (t & 1) ? a.up : a.pair;
+        merge_accum(s.m[size_t(pair)], a);
+        uint8_t& seen = mb.seen[size_t(pair)];
+        if (!seen) seen = 1, touched.push_back(pair);
       }
     // Coefficients of the touched pairs (each depends on its own statistics only), in pair order for locality
     // (this and the weight refold that follows): where most of the bucket was touched, by a scan of its flags.

@@ -83,7 +83,8 @@ struct bayes_stats {
   std::vector<float> mu0;                // region-prior mode: the pair's prior mean of z (set with its region)
   std::vector<float> w;                  // region-prior mode: W per pair (+ 4 padding entries for SSE loads)
   std::vector<float> w_cv, cv;           // control variates: W of the residual, and E[1 - p0] k (+ 4 padding each)
-  std::vector<float> p1_folded;          // per pair: its p1 when its children's weights were last folded (hierarchy)
+  std::vector<float> p1_folded;          // hierarchy, per pair: a parent's p1 when its children were last examined;
+                                         // a child's p1 folded into its weight
   merge_buffers scratch;
 };
 
@@ -107,6 +108,7 @@ inline double pair_p1(const bayes_stats& s, size_t i, int up, const bayes_params
 inline double eval_weight(const pair_weight& h, const bayes_params& p, double v, double g);
 inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
   double p1 = pair_p1(s, i, up, p);
+  if (up >= 0) s.p1_folded[i] = float(p1);  // a child: the p1 its weight now holds (see bayes_sampler::refold)
   const pair_coeffs& c = s.coeffs[i];
   pair_weight pw = {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
   s.weight[i] = pw;  // read by every shading point in point-prior mode (and by the tests)
@@ -150,6 +152,8 @@ struct bayes_row {
   std::vector<int> slots;        // power-of-two table of indices into acc (-1: empty)
   std::vector<pair_accum> acc;   // in first-touch order (deterministic within the row)
   std::vector<int> used;         // slots in use (cleared one by one: cheaper than refilling the table)
+  std::vector<uint32_t> order;   // merge_rows: the row's updates (acc index * 2 + 1 for the parent's) by bucket
+  std::vector<uint32_t> start;   // merge_rows: where each bucket's updates begin in `order` (buckets + 1)
   void clear();
   void add(int pair, double z);
 };
