@@ -8,6 +8,7 @@
 #include <xmmintrin.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -255,50 +256,60 @@ void bayes_sampler::learn(std::vector<row_state>& rows) {
   timing.reduce += secs(t0, t1);
   timing.regions += secs(t1, t2);
   timing.refold += secs(t2, t3);
+  for (const row_state& row : rows) timing.records += double(row.acc.size());
 }
 
 void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
   const bool hier = params.hierarchy > 0 && params.prior;
+  std::atomic<int64_t> folds{0};  // counted per task (profiles)
   auto fold = [&](size_t i) { fold_weight(stats, i, hier ? regions.pair_parent[i] : invalid_id, params); };
-  // Touched pairs and new pairs: their own statistics (or prior) changed. Each pair independently.
+  // Children of coarse pairs whose p1 moved by more than the tolerance since their children were last examined. A
+  // child's p1 = (s p1_parent + n1) / (s + n) moves, relative to itself, by at most the parent's relative move; an
+  // examined child is refolded when its own p1 moved by more than the tolerance from the one its weight holds (a
+  // child with many samples of its own barely follows its parent). So a child's p1 is never more than about twice
+  // the tolerance from its exact value (which it gets whenever it is touched itself). Below p1_floor the tolerance
+  // is absolute (tol * p1_floor): a cluster the region nearly never sees keeps a small weight either way. The
+  // decisions depend on the statistics only: deterministic. Work: the touched pairs and the moved ones' children.
+  const double tol = params.refold_tolerance;
+  constexpr double p1_floor = 0.1;
+  auto moved_by = [&](double now, double then) { return std::fabs(now - then) > tol * std::max(then, p1_floor); };
+  std::vector<uint8_t>& moved = stats.scratch.seen;  // all zero between uses; sized for the old pairs
+  // Touched pairs (their own statistics changed), flagging the coarse ones that moved.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& g) {
-    for (size_t k = g.begin(); k < g.end(); k++) fold(size_t(touched[k]));
+    for (size_t t = g.begin(); t < g.end(); t++) {
+      size_t k = size_t(touched[t]);
+      fold(k);
+      if (!hier || first_child[k] == invalid_id) continue;  // no children (a fine pair, or none created yet)
+      float now = stats.coeffs[k].p1;
+      if (!moved_by(now, stats.p1_folded[k])) continue;
+      stats.p1_folded[k] = now;
+      moved[k] = 1;
+    }
+    folds.fetch_add(int64_t(g.size()), std::memory_order_relaxed);
   });
+  // New pairs (their prior was just set).
   size_t pairs = stats.m.size();
   tbb::parallel_for(tbb::blocked_range<size_t>(old_pairs, pairs, 1024), [&](const tbb::blocked_range<size_t>& g) {
     for (size_t i = g.begin(); i < g.end(); i++) {
       fold(i);
       if (regions.pair_parent[i] == invalid_id) stats.p1_folded[i] = stats.coeffs[i].p1;
     }
+    folds.fetch_add(int64_t(g.size()), std::memory_order_relaxed);
   });
-  if (!hier) return;
-  // Children of coarse pairs whose p1 moved by more than the tolerance since their children were last folded. A
-  // child's p1 = (s p1_parent + n1) / (s + n) moves, relative to itself, by at most the parent's relative move, so
-  // a child's p1 is never more than about twice the tolerance away from its exact value (which it gets whenever it
-  // is touched itself). The decisions depend on the statistics only: deterministic. Work: the children of the
-  // moved pairs only.
-  std::vector<int> moved;
-  const double tol = params.refold_tolerance;
-  // Below p1_floor the tolerance is absolute (tol * p1_floor): a cluster the region nearly never sees keeps a
-  // small weight either way, and whenever a child of it is sampled it is touched and refolded exactly.
-  constexpr double p1_floor = 0.1;
-  for (int i : touched) {
-    size_t k = size_t(i);
-    if (first_child[k] == invalid_id) continue;  // no children (a fine pair, or a coarse one without any yet)
-    float now = stats.coeffs[k].p1, then = stats.p1_folded[k];
-    if (!(std::fabs(double(now) - double(then)) > tol * std::max(double(then), p1_floor))) continue;
-    moved.push_back(i);
-    stats.p1_folded[k] = now;
-  }
-  // A child is refolded when its own p1 moved by more than the tolerance from the one its weight holds (a child
-  // with many samples of its own barely follows its parent).
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, moved.size(), 16), [&](const tbb::blocked_range<size_t>& g) {
-    for (size_t m = g.begin(); m < g.end(); m++)
-      for (int c = first_child[size_t(moved[m])]; c != invalid_id; c = next_sibling[size_t(c)]) {
-        double now = pair_p1(stats, size_t(c), moved[m], params), then = stats.p1_folded[size_t(c)];
-        if (std::fabs(now - then) > tol * std::max(then, p1_floor)) fold(size_t(c));
+  // Children of the moved pairs (each child has one parent: no pair is folded by two tasks).
+  if (hier)
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& g) {
+      int64_t count = 0;
+      for (size_t t = g.begin(); t < g.end(); t++) {
+        int k = touched[t];
+        if (!moved[size_t(k)]) continue;
+        moved[size_t(k)] = 0;
+        for (int c = first_child[size_t(k)]; c != invalid_id; c = next_sibling[size_t(c)])
+          if (moved_by(pair_p1(stats, size_t(c), k, params), stats.p1_folded[size_t(c)])) fold(size_t(c)), count++;
       }
-  });
+      folds.fetch_add(count, std::memory_order_relaxed);
+    });
+  timing.refolds += double(folds.load());
 }
 
 }  // namespace bl

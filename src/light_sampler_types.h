@@ -37,6 +37,8 @@ struct learn_timing {
   double reduce = 0;   // folding the passes' observation records into the statistics (and their coefficients)
   double regions = 0;  // creating requested regions, their cuts and prior means
   double refold = 0;   // folding the posterior into the sampling weights of the pairs that changed
+  double records = 0;  // observation records folded (one per pair per row state per pass)
+  double refolds = 0;  // sampling weights refolded
 };
 
 // What light selection sees of a shading point.

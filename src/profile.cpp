@@ -155,6 +155,9 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
          100 * lp.regions / b.seconds);
     line("  %-44s %10.1f %7.1f%%\n", "  of which: refold of changed weights", lp.refold / nee * 1e9,
          100 * lp.refold / b.seconds);
+    line("  %-44s %10.2f records, %.2f refolds per NEE sample (%.1f, %.1f ns each)\n", "  learning work:",
+         lp.records / nee, lp.refolds / nee, lp.reduce / std::max(lp.records, 1.0) * 1e9,
+         lp.refold / std::max(lp.refolds, 1.0) * 1e9);
   }
   line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee * 1e9, 100.0);
   line("\n  raw Embree rtcOccluded1 on this scene: %.2f M rays/s (%zu rays, %d threads)\n", limit * 1e-6,
