@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <thread>
@@ -162,8 +163,27 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
   line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee * 1e9, 100.0);
   line("\n  raw Embree rtcOccluded1 on this scene: %.2f M rays/s (%zu rays, %d threads)\n", limit * 1e-6,
        rays.org.size(), threads);
-  if (limit > 0)
+  if (limit > 0) {
     line("  render NEE samples/s as a fraction of the raw shadow-ray limit: %.3f\n", nee / a.seconds / limit);
+    // Why the fraction is below 1: what else a NEE sample pays for, from the timed render's stages.
+    auto stage_wall = [&](int c) { return double(b.profile_cycles[c]) / hz / threads; };
+    std::vector<std::pair<double, std::string>> others;
+    for (int c = 0; c < prof_count; c++)
+      if (c != prof_shadow) others.push_back({stage_wall(c), stage_name(c)});
+    others.push_back({rest, "film, scheduling and timer overhead"});
+    others.push_back({b.learn_seconds, "learning between passes"});
+    std::sort(others.begin(), others.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+    line("  why: shadow rays are %.1f%% of the timed render; the largest other parts:", 100 * stage_wall(prof_shadow) / b.seconds);
+    for (size_t k = 0; k < 3 && k < others.size(); k++)
+      line("%s %s %.1f%%", k ? "," : "", others[k].second.c_str(), 100 * others[k].first / b.seconds);
+    line("\n");
+    // Each NEE sample of a direct-only render pays one camera ray: with one NEE sample per camera hit the fraction
+    // cannot exceed t_raw / (t_raw + t_camera) even if everything else were free.
+    double t_raw = 1 / limit, t_cam = stage_wall(prof_camera) / nee;
+    if (params.max_depth == 1 && t_cam > 0)
+      line("  with one NEE sample per camera ray the fraction is at most %.2f (a camera ray costs %.1f raw shadow rays "
+           "here)\n", t_raw / (t_raw + t_cam), t_cam / t_raw);
+  }
   line("  between-pass learning: %.2f%% of the plain render's time\n", 100 * a.learn_seconds / std::max(a.seconds, 1e-9));
   line("  timers cost: the timed render took %.1f%% longer than the plain one\n", 100 * (b.seconds / a.seconds - 1));
   if (a.regions > 0)

@@ -28,11 +28,37 @@ if [[ " $sections " == *" micro "* ]] && [ -x "$build/bayeslight_bench" ]; then
   "$build/bayeslight_bench" --benchmark_min_time=1
 fi
 if [[ " $sections " == *" profile "* ]]; then
+  # At each scene's own settings (640x480, 64 spp: what a render gets by default), then the bayes/bound summary.
   for sc in cornell living_room plant_room hall; do
     for s in bound bayes; do
-      echo "== profile: data/$sc/direct.json, $s, 320x240, 32 spp"
-      "$bin" profile "data/$sc/direct.json" --sampler "$s" --width 320 --height 240 --spp 32 | tail -n +2
+      echo "== profile: data/$sc/direct.json, $s (the scene's own size and spp)"
+      "$bin" profile "data/$sc/direct.json" --sampler "$s" | tee "$tmp/prof_${sc}_$s.txt" | tail -n +2
     done
+  done
+  echo "== profile summary (direct only): NEE samples/s of bayes over bound, fraction of raw Embree, learning share"
+  for sc in cornell living_room plant_room hall; do
+    rate() { sed -n 's/.*NEE samples (\([0-9.]*\) M\/s).*/\1/p' "$tmp/prof_${sc}_$1.txt"; }
+    frac() { sed -n 's/.*fraction of the raw shadow-ray limit: \([0-9.]*\).*/\1/p' "$tmp/prof_${sc}_$1.txt"; }
+    learn() { sed -n 's/.*between-pass learning: \([0-9.]*\)%.*/\1/p' "$tmp/prof_${sc}_$1.txt"; }
+    mem() { sed -n 's/.*pairs, \([0-9.]*\) bytes per pair.*/\1/p' "$tmp/prof_${sc}_$1.txt"; }
+    printf "  %-12s one run: bayes/bound %s (%s / %s M NEE/s)  raw fraction bayes %s bound %s  learning bayes %s%% bound %s%%  bytes/pair %s\n" \
+      "$sc" "$(awk -v a="$(rate bayes)" -v b="$(rate bound)" 'BEGIN { printf "%.2f", a / b }')" "$(rate bayes)" "$(rate bound)" \
+      "$(frac bayes)" "$(frac bound)" "$(learn bayes)" "$(learn bound)" "$(mem bayes)"
+  done
+  # The machine is shared: the speed ratio again as the median of ROUNDS interleaved plain renders of each.
+  rounds=${ROUNDS:-3}
+  echo "== bayes over bound, NEE samples/s: median of $rounds interleaved renders each (the scene's own size and spp)"
+  for sc in cornell living_room plant_room hall; do
+    : >"$tmp/r_bound"; : >"$tmp/r_bayes"
+    for ((k = 0; k < rounds; k++)); do
+      for s in bound bayes; do
+        "$bin" render "data/$sc/direct.json" --sampler "$s" -o "$tmp/r.pfm" 2>&1 |
+          sed -n 's/^rendered .*, \([0-9.]*\) M NEE samples\/s).*/\1/p' >>"$tmp/r_$s"
+      done
+    done
+    med() { sort -g "$1" | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
+    printf "  %-12s bayes %s, bound %s M NEE/s: %s\n" "$sc" "$(med "$tmp/r_bayes")" "$(med "$tmp/r_bound")" \
+      "$(awk -v a="$(med "$tmp/r_bayes")" -v b="$(med "$tmp/r_bound")" 'BEGIN { printf "%.2f", a / b }')"
   done
 fi
 if [[ " $sections " == *" stress "* ]]; then
