@@ -221,7 +221,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
   h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
-  h.value(b.oracle_spp);
+  h.value(b.oracle_spp), h.value(b.refold_tolerance);
   const donikian_params& d = p.sampler.donikian;
   h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
   return h.h;

@@ -127,7 +127,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
 size_t sampler_memory_bytes(const light_sampler& s) {
   if (auto* b = std::get_if<bound_sampler>(&s)) return region_memory_bytes(b->regions);
   if (auto* b = std::get_if<bayes_sampler>(&s))
-    return region_memory_bytes(b->regions) + b->stats.m.size() * (sizeof(pair_moments) + sizeof(pair_coeffs) + sizeof(pair_weight) + 5 * sizeof(float));
+    return region_memory_bytes(b->regions) + b->stats.m.size() * (sizeof(pair_moments) + sizeof(pair_coeffs) + sizeof(pair_weight) + 5 * sizeof(float) + 2 * sizeof(int));
   if (auto* d = std::get_if<donikian_sampler>(&s))
     return region_memory_bytes(d->deeper.regions) +
            (d->pixel_sum.size() + d->pixel_count.size() + d->block_sum.size() + d->block_count.size()) * sizeof(float);
