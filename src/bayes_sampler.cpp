@@ -170,7 +170,17 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
       z *= d * d;
     }
   }
-  row.add(ctx.pair_base + j, z);
+  // The accumulator of (region, j): cached in the context while it records into the same row state and region (a
+  // hash lookup only the first time).
+  if (ctx.rec_owner != &row || ctx.rec_generation != row.generation || ctx.rec_base != ctx.pair_base) {
+    ctx.rec_owner = &row;
+    ctx.rec_generation = row.generation;
+    ctx.rec_base = ctx.pair_base;
+    std::fill(ctx.rec_slot, ctx.rec_slot + ctx.count, -1);
+  }
+  int& slot = ctx.rec_slot[j];
+  if (slot < 0) slot = row.slot_of(ctx.pair_base + j);
+  row.add_at(slot, z);
 }
 
 void bayes_sampler::begin_frame(double decay) {

@@ -103,9 +103,10 @@ void bayes_row::clear() {
   for (int h : used) slots[size_t(h)] = -1;
   used.clear();
   acc.clear();
+  generation++;
 }
 
-void bayes_row::add(int pair, double z) {
+int bayes_row::slot_of(int pair) {
   if (2 * (acc.size() + 1) > slots.size()) {
     // Grow and rehash (load <= 1/2).
     size_t n = std::max<size_t>(64, slots.size() * 2);
@@ -126,7 +127,11 @@ void bayes_row::add(int pair, double z) {
     used.push_back(int(h));
     acc.push_back({pair, invalid_id, 0, 0, 0, 0});
   }
-  pair_accum& a = acc[size_t(slots[h])];
+  return slots[h];
+}
+
+void bayes_row::add_at(int index, double z) {
+  pair_accum& a = acc[size_t(index)];
   if (z == 0) {
     a.n0 += 1;
     return;

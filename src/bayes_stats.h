@@ -154,8 +154,13 @@ struct bayes_row {
   std::vector<int> used;         // slots in use (cleared one by one: cheaper than refilling the table)
   std::vector<uint32_t> order;   // merge_rows: the row's updates (acc index * 2 + 1 for the parent's) by bucket
   std::vector<uint32_t> start;   // merge_rows: where each bucket's updates begin in `order` (buckets + 1)
+  uint64_t generation = 0;      // incremented by clear(): caches of accumulator indices check it
   void clear();
-  void add(int pair, double z);
+  // Index in acc of pair's accumulator (created empty if absent).
+  int slot_of(int pair);
+  // Adds sample z to accumulator acc[index] (Welford).
+  void add_at(int index, double z);
+  void add(int pair, double z) { add_at(slot_of(pair), z); }
 };
 
 // Folds the rows, in order, into the statistics (Chan's parallel update) — each accumulator into its pair and

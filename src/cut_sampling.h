@@ -36,6 +36,12 @@ struct cut_context {
   bool cv = false;
   vec3f cv_sum = {0, 0, 0};
   float cvg[max_cut_entries + 3];
+  // Recording cache (bayes): the row-state accumulator of each cluster of the current region, valid while the
+  // same row state (and generation of it) and region are recorded into; -1: not looked up yet.
+  mutable const void* rec_owner = nullptr;
+  mutable uint64_t rec_generation = 0;
+  mutable int rec_base = -1;
+  mutable int rec_slot[max_cut_entries];
 };
 
 // Fills the point and region part of a context. The region part is kept while the cell stays the same (contexts
