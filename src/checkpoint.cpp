@@ -15,7 +15,7 @@ namespace bl {
 namespace {
 
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
-constexpr uint32_t version = 2;  // 2: pass schedule and lazy refold changed (a resume would not match)
+constexpr uint32_t version = 3;  // 2: pass schedule and lazy refold changed; 3: weighted passes (film weight)
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -214,6 +214,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(scene.sun.enabled), h.vec(scene.sun.direction), h.vec(scene.sun.irradiance);
   h.value(scene.sun.angular_diameter_deg), h.value(scene.two_sided_emitters);
   h.value(p.width), h.value(p.height), h.value(p.max_depth), h.value(p.seed), h.value(int(p.sampler.kind));
+  h.value(p.pass_weighting);
   const region_params& r = p.sampler.regions;
   h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
   h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
@@ -242,6 +243,7 @@ std::string encode_checkpoint(uint64_t fingerprint, const render_result& result,
     w.value(p.error.relmse), w.value(p.error.mse), w.value(p.error.maxabs);
   }
   w.column(result.film);
+  w.value(result.film_weight);
   write_sampler(w, sampler);
   hasher h;
   h.bytes(w.out.data(), w.out.size());
@@ -281,7 +283,9 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
     result.log.push_back(p);
   }
   result.film = r.column<double>(size_t(w) * size_t(hgt) * 3);
-  if (result.passes < 0 || result.spp < 0) r.fail("pass state");
+  result.film_weight = r.value<double>();
+  if (result.passes < 0 || result.spp < 0 || !(result.film_weight >= 0) || (result.spp > 0) != (result.film_weight > 0))
+    r.fail("pass state");
   read_sampler(r, sampler);
   if (r.pos != body.size()) r.fail("trailing data");
 }

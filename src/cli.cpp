@@ -57,6 +57,7 @@ struct render_options {
   std::string bayes_prior = "region";
   int frames = 1;
   double frame_decay = 0.5;
+  double pass_weighting = 4;
   std::string checkpoint;
   double checkpoint_every = 30;
   std::string resume;
@@ -112,6 +113,7 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.sampler.bayes.region_prior = o.bayes_prior == "region";
   p.frames = o.frames;
   p.frame_decay = o.frame_decay;
+  p.pass_weighting = o.pass_weighting;
   p.progress = !o.quiet && stderr_is_terminal();
   return p;
 }
@@ -257,6 +259,11 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--width", o.width, "Image width in pixels")->check(CLI::Range(1ll, max_side));
   r->add_option("--height", o.height, "Image height in pixels")->check(CLI::Range(1ll, max_side));
   r->add_flag("--quiet", o.quiet, "No progress bar or summary");
+  r->add_option("--pass-weighting", o.pass_weighting,
+                "Adaptive samplers (bayes, donikian): a pass after n spp counts (n+1)/(n+1+S) per sample, so the first "
+                "passes, taken before much is learned, weigh less; fixed in advance, so the image stays unbiased "
+                "(default 4; 0: all samples alike)")
+      ->check(CLI::Range(0.0, 1e9));
   // Regions, cuts and the ablation switches of the adaptive samplers.
   const char* grp = "Regions and light cuts (bound, bayes)";
   r->add_option("--grid", o.regions.grid, "Region cells along the shortest axis of the scene bounds (default 64)")

@@ -35,6 +35,9 @@ struct render_params {
   bool profile = false;       // time the hot path's stages (profile_timers.h) into render_result::profile_cycles
   int frames = 1;             // animation frames (the sun moves from sun.direction to sun.direction_end)
   double frame_decay = 0.5;   // learned statistics are scaled by this at the start of every frame after the first
+  // Adaptive samplers (bayes, donikian): the samples of a pass taken after n spp count pass_weight(n, this)
+  // times in the image (0: all alike). Fixed in advance, so the weighted mean stays unbiased.
+  double pass_weighting = 4;
   std::vector<const image_data*> frame_references;  // per frame (overrides `reference` when not empty)
   // Called after every completed pass (last = false) and once when the render ends (last = true), with the state
   // of the completed passes: what a checkpoint saves.
@@ -55,7 +58,8 @@ struct pass_record {
 // The outcome of a render.
 struct render_result {
   int width = 0, height = 0;
-  std::vector<double> film;   // per pixel RGB sums over all completed samples
+  std::vector<double> film;   // per pixel RGB sums over all completed samples, each pass's times its weight
+  double film_weight = 0;     // the sum of the weights of one pixel's samples (= spp when all weigh 1)
   int spp = 0;                // samples per pixel in the film
   int passes = 0;
   bool interrupted = false;
@@ -73,6 +77,8 @@ struct render_result {
 
 // Samples per pixel of pass `pass` given `done` samples before it (before truncation to the target).
 int pass_size(int pass, int done);
+// Weight of the samples of a pass that starts after `done` spp: (done + 1) / (done + 1 + s), 1 for s = 0.
+double pass_weight(int done, double s);
 
 // Renders the scene.
 render_result render(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
@@ -84,7 +90,7 @@ render_result render(const scene_data& scene, const bvh_data& bvh, const light_d
 // on_frame(k, result) after each frame; stops after an interrupted frame (its result says so).
 void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lights, const render_params& params,
                    const std::function<void(int, const render_result&)>& on_frame);
-// The film's mean image (zero when no sample completed).
+// The film's weighted mean image (zero when no sample completed).
 image_data film_image(const render_result& r);
 
 // Installs SIGINT/SIGTERM handlers that request the render to stop; returns the signal seen (0: none).

@@ -106,7 +106,7 @@ TEST_CASE("a long render stays accurate", "[scale]") {
   double A = a / h, s = A / std::sqrt(1 + A * A);
   double exact = rho / M_PI * 4 * le * s * std::atan(s);
   std::vector<double> px;
-  for (int i = 0; i < 64; i++) px.push_back(r.film[3 * size_t(i)] / r.spp);
+  for (int i = 0; i < 64; i++) px.push_back(r.film[3 * size_t(i)] / r.film_weight);
   mean_se m = mean_and_se(px);
   INFO("mean " << m.mean << " +- " << m.se << " exact " << exact);
   CHECK(m.se < 0.002 * exact);

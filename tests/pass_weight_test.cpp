@@ -1,0 +1,152 @@
+// Weighted passes (render_params::pass_weighting): an adaptive sampler's image is sum_k w_k S_k / sum_k w_k n_k,
+// S_k the sample sums of pass k, n_k its spp and w_k = pass_weight(spp before pass k) fixed in advance. Checked
+// against renders without weighting (whose films give every pass's sums, since weighting never changes what is
+// sampled or learned); non-adaptive and frozen samplers keep equal weights bit for bit; and on a scene where the
+// prior is poor (a bright lamp shut in a box beside a dim one) weighting lowers the error, paired over seeds.
+#include "bvh.h"
+#include "lights.h"
+#include "render.h"
+#include "scene.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <memory>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+struct built_scene {
+  scene_data scene;
+  bvh_data bvh;
+  light_data lights;
+};
+
+// The floor beside a closed box that holds a bright lamp, lit only by a dim lamp outside: the bound prior sends
+// most NEE samples to the shut-in lamp until learning moves them.
+std::unique_ptr<built_scene> boxed_lamp_scene() {
+  mesh_builder m;
+  int floor = m.add_material({0.5f, 0.5f, 0.5f});
+  int box = m.add_material({0.6f, 0.6f, 0.6f});
+  int bright = m.add_material({0, 0, 0}, {200, 200, 200});
+  int dim = m.add_material({0, 0, 0}, {1, 1, 1});
+  m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
+  m.add_box({-0.5f, 0.01f, -0.5f}, {0.5f, 1, 0.5f}, box);
+  m.add_quad({-0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, 0.1f}, {-0.1f, 0.9f, 0.1f}, bright);
+  m.add_quad({1, 2, -0.25f}, {1.5f, 2, -0.25f}, {1.5f, 2, 0.25f}, {1, 2, 0.25f}, dim);
+  camera_params cam;
+  cam.automatic = false;
+  cam.eye = {2, 4, 0.01f};
+  cam.target = {2, 0, 0};
+  cam.up = {0, 0, -1};
+  cam.fov_y_deg = 40;
+  auto b = std::make_unique<built_scene>();
+  b->scene = build_scene(std::move(m.mesh), cam, {}, false, 1.0f);
+  b->bvh = build_bvh(b->scene);
+  b->lights = build_lights(b->scene);
+  return b;
+}
+
+render_params small_params(sampler_kind kind, int spp, double weighting, uint64_t seed = 7) {
+  render_params p;
+  p.width = p.height = 12;
+  p.spp = spp;
+  p.max_depth = 1;
+  p.threads = 2;
+  p.seed = seed;
+  p.sampler.kind = kind;
+  p.pass_weighting = weighting;
+  return p;
+}
+
+double squared_error(const image_data& a, const image_data& ref) {
+  double e = 0;
+  for (size_t i = 0; i < a.pixels.size(); i++) e += std::pow(double(a.pixels[i]) - ref.pixels[i], 2);
+  return e / double(a.pixels.size());
+}
+
+}  // namespace
+
+TEST_CASE("pass weights start below one and approach it", "[passes]") {
+  CHECK(pass_weight(0, 4) == Approx(0.2));
+  CHECK(pass_weight(15, 4) == Approx(0.8));
+  CHECK(pass_weight(1000, 4) > 0.99);
+  CHECK(pass_weight(1000, 4) < 1.0);
+  for (int n : {0, 3, 100}) CHECK(pass_weight(n, 0) == 1.0);
+  for (int n = 0; n < 100; n++) CHECK(pass_weight(n + 1, 4) > pass_weight(n, 4));
+}
+
+TEST_CASE("an adaptive sampler's film is each pass's sums times the pass's fixed weight", "[passes]") {
+  auto b = boxed_lamp_scene();
+  for (sampler_kind kind : {sampler_kind::bayes, sampler_kind::donikian}) {
+    INFO(sampler_name(kind));
+    // Unweighted renders that stop at every pass boundary up to 15 spp: their films are the cumulative sums.
+    const int ends[] = {1, 2, 3, 4, 5, 6, 7, 8, 10, 12, 15};
+    std::vector<std::vector<double>> cumulative;
+    for (int e : ends) {
+      render_result r = render(b->scene, b->bvh, b->lights, small_params(kind, e, 0));
+      REQUIRE(r.spp == e);
+      CHECK(r.film_weight == double(e));
+      cumulative.push_back(r.film);
+    }
+    render_result w = render(b->scene, b->bvh, b->lights, small_params(kind, 15, 4));
+    REQUIRE(w.spp == 15);
+    REQUIRE(w.passes == 11);
+    double weight = 0;
+    std::vector<double> expect(w.film.size(), 0.0);
+    int before = 0;
+    for (size_t k = 0; k < cumulative.size(); k++) {
+      double wk = pass_weight(before, 4);
+      weight += wk * (ends[k] - before);
+      for (size_t i = 0; i < expect.size(); i++)
+        expect[i] += wk * (cumulative[k][i] - (k > 0 ? cumulative[k - 1][i] : 0.0));
+      before = ends[k];
+    }
+    CHECK(w.film_weight == Approx(weight).epsilon(1e-12));
+    CHECK(w.film_weight < 15);
+    double worst = 0, scale = 0;
+    for (size_t i = 0; i < expect.size(); i++) {
+      worst = std::max(worst, std::fabs(w.film[i] - expect[i]));
+      scale = std::max(scale, std::fabs(expect[i]));
+    }
+    REQUIRE(scale > 0);
+    CHECK(worst <= 1e-9 * scale);
+  }
+}
+
+TEST_CASE("non-adaptive and frozen samplers keep equal weights bit for bit", "[passes]") {
+  auto b = boxed_lamp_scene();
+  for (sampler_kind kind : {sampler_kind::uniform, sampler_kind::power, sampler_kind::bvh, sampler_kind::bound}) {
+    INFO(sampler_name(kind));
+    render_result a = render(b->scene, b->bvh, b->lights, small_params(kind, 12, 0));
+    render_result w = render(b->scene, b->bvh, b->lights, small_params(kind, 12, 4));
+    CHECK(w.film_weight == 12.0);
+    CHECK(w.film == a.film);
+  }
+  render_params p0 = small_params(sampler_kind::bayes, 12, 0), p4 = small_params(sampler_kind::bayes, 12, 4);
+  p0.sampler.bayes.oracle_spp = p4.sampler.bayes.oracle_spp = 16;
+  render_result a = render(b->scene, b->bvh, b->lights, p0);
+  render_result w = render(b->scene, b->bvh, b->lights, p4);
+  CHECK(w.film_weight == 12.0);
+  CHECK(w.film == a.film);
+}
+
+TEST_CASE("weighting the first passes lowers bayes's error where the prior is poor", "[passes]") {
+  // Paired over 16 seeds (the same samples with and without weighting): the mean of e_0 - e_w, the difference of
+  // squared errors against a 16384-spp reference, must exceed 3.7 standard errors (one-sided 99.99 %).
+  auto b = boxed_lamp_scene();
+  render_params rp = small_params(sampler_kind::bayes, 16384, 4, 987654321);
+  image_data ref = film_image(render(b->scene, b->bvh, b->lights, rp));
+  std::vector<double> diff;
+  for (uint64_t seed = 1; seed <= 16; seed++) {
+    image_data plain = film_image(render(b->scene, b->bvh, b->lights, small_params(sampler_kind::bayes, 27, 0, seed)));
+    image_data weighted = film_image(render(b->scene, b->bvh, b->lights, small_params(sampler_kind::bayes, 27, 4, seed)));
+    diff.push_back(squared_error(plain, ref) - squared_error(weighted, ref));
+  }
+  mean_se m = mean_and_se(diff);
+  INFO("mean gain " << m.mean << " +- " << m.se);
+  CHECK(m.mean > 3.7 * m.se);
+}
