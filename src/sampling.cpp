@@ -92,8 +92,16 @@ discrete_data make_discrete(const float* weights, int n) {
 }
 
 int sample_cdf(const double* cdf, int n, double u) {
-  // First cdf entry > u, minus one: the item whose half-open cell [cdf[i], cdf[i+1]) contains u.
-  int i = int(std::upper_bound(cdf + 1, cdf + n + 1, u) - (cdf + 1));
+  // First cdf entry > u, minus one: the item whose half-open cell [cdf[i], cdf[i+1]) contains u. Short cdfs
+  // (most cuts: a handful of clusters) count the entries <= u without branches, which is the same index for a
+  // non-decreasing cdf and avoids the binary search's unpredictable jumps.
+  int i;
+  if (n <= 16) {
+    i = 0;
+    for (int k = 1; k <= n; k++) i += cdf[k] <= u;
+  } else {
+    i = int(std::upper_bound(cdf + 1, cdf + n + 1, u) - (cdf + 1));
+  }
   return std::min(std::max(i, 0), n - 1);
 }
 
