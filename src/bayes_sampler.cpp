@@ -19,6 +19,9 @@ namespace {
 // Prior scale of a point: a Lambertian point of albedo a turns irradiance E into radiance a E / pi.
 double point_scale(float albedo) { return double((albedo > 0 ? albedo : 1.0f) * inv_pi_f); }
 
+// Least receiver cosine factor of a cluster the front test keeps (it stays possible, and z = Y / factor bounded).
+constexpr float orientation_floor = 1e-3f;
+
 }  // namespace
 
 void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
@@ -96,13 +99,16 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   ctx.cv = params.control_variate && sp.last;
   const float* W = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
   const float* mu0 = stats.mu0.data() + base;
-  alignas(16) float wf[max_cut_entries + 3], gf[max_cut_entries + 3];
+  alignas(16) float wf[max_cut_entries + 3];
+  float* gf = ctx.gfac;
   const int tc = ctx.tree_count;
   const __m128 px = _mm_set1_ps(sp.p.x), py = _mm_set1_ps(sp.p.y), pz = _mm_set1_ps(sp.p.z);
   const __m128 nx = _mm_set1_ps(sp.n.x), ny = _mm_set1_ps(sp.n.y), nz = _mm_set1_ps(sp.n.z);
   const __m128 one = _mm_set1_ps(1.0f), slack = _mm_set1_ps(1e-5f);
+  const __m128 orient_floor = _mm_set1_ps(orientation_floor), tiny = _mm_set1_ps(1e-30f);
   const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
   const bool regression = params.distance_regression;
+  const bool orientation = params.orientation;
   for (int j0 = 0; j0 < tc; j0 += 4) {
     // (cx, cy, cz, r) of four nodes (missing lanes repeat the last node; their results are never read).
     __m128 c0 = _mm_loadu_ps(&tree->packed[size_t(ctx.nodes[std::min(j0 + 0, tc - 1)])].cx);
@@ -116,13 +122,22 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     __m128 dn = _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, dx), _mm_mul_ps(ny, dy)), _mm_mul_ps(nz, dz));
     __m128 l1 = _mm_add_ps(_mm_add_ps(_mm_and_ps(dx, abs_mask), _mm_and_ps(dy, abs_mask)), _mm_and_ps(dz, abs_mask));
     __m128 front = _mm_cmplt_ps(dn, _mm_add_ps(c3, _mm_mul_ps(slack, l1)));
+    if (orientation) {
+      // Receiver cosine factor toward the cluster's bounding sphere: (r - n.(p - c)) / d = cos theta_i + r / d,
+      // theta_i the angle between n and the direction to the centre, clamped to [orientation_floor, 1] (so that
+      // every cluster the front test keeps stays possible, and z = Y / factor stays bounded).
+      __m128 c = _mm_div_ps(_mm_sub_ps(c3, dn), _mm_max_ps(_mm_sqrt_ps(d2), tiny));
+      g = _mm_mul_ps(g, _mm_min_ps(one, _mm_max_ps(c, orient_floor)));
+    }
     g = _mm_and_ps(front, g);
-    _mm_store_ps(gf + j0, g);
+    _mm_storeu_ps(gf + j0, g);
     _mm_store_ps(wf + j0, _mm_mul_ps(_mm_loadu_ps(W + j0), g));
     if (ctx.cv) _mm_storeu_ps(ctx.cvg + j0, _mm_mul_ps(_mm_loadu_ps(stats.cv.data() + base + size_t(j0)), g));
   }
   if (tc < ctx.count) {
-    gf[tc] = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
+    float front = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
+    float cos_bound = orientation ? receiver_cos_bound(sp.n, lights->sun_dir, sun_sin, sun_cos) : 1.0f;
+    gf[tc] = front * std::min(1.0f, std::max(cos_bound, orientation_floor));
     wf[tc] = W[tc] * gf[tc];
   }
   if (ctx.cv) {
@@ -164,8 +179,11 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   if (j < 0 || ctx.count == 1) return;
   double z = e.value;
   if (z > 0) {
-    if (params.region_prior) z /= point_scale(ctx.albedo);  // the albedo-free sample (see bayes_stats)
-    if (params.distance_regression) {
+    if (params.region_prior) {
+      // The albedo-free sample (see bayes_stats) over the point factor the pmf used: z = Y d^2 / cos bound.
+      z /= point_scale(ctx.albedo);
+      if (params.distance_regression || params.orientation) z /= double(ctx.gfac[j]);
+    } else if (params.distance_regression) {
       double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
       z *= d * d;
     }

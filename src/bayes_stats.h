@@ -38,6 +38,9 @@ struct bayes_params {
   double refold_tolerance = 0.05;  // hierarchy: a coarse pair's children are refolded when its p1 has moved by more
                                    // than this fraction (of max(p1, 0.1)) since their last fold (a child's p1 moves
                                    // by at most that fraction too); 0: whenever it changes at all
+  bool orientation = true;       // region prior: the point factor of a cluster is its receiver cosine bound / d^2
+                                 // (z = Y d^2 / cos), not 1 / d^2 alone: the regression also learns what the
+                                 // orientation of the point explains
   bool control_variate = true;   // region prior only: where NEE is unweighted (direct illumination, the last path
                                  // vertex), add the learned mean c_j = E[1 - p0] k_j / d^2 of every cluster and
                                  // estimate the residual (Y_J - c_J) / P_J, with P_j proportional to the root of the

@@ -15,7 +15,7 @@ namespace bl {
 namespace {
 
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
-constexpr uint32_t version = 3;  // 2: pass schedule and lazy refold changed; 3: weighted passes (film weight)
+constexpr uint32_t version = 4;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -222,7 +222,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
   h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
-  h.value(b.oracle_spp), h.value(b.refold_tolerance);
+  h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation);
   const donikian_params& d = p.sampler.donikian;
   h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
   return h.h;

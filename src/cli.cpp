@@ -294,6 +294,9 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--bayes-cv-min-visible", o.bayes.cv_min_visible,
                 "Control variates only for clusters a region sees with probability at least this (default 0.98)")
       ->check(CLI::Range(0.0, 1.0))->group(bg);
+  r->add_flag_callback("--bayes-no-orientation", [&o] { o.bayes.orientation = false; },
+                       "Ablation: a point scales a cluster's weight by 1/d^2 only, not also by the receiver cosine bound")
+      ->group(bg);
   r->add_flag_callback("--bayes-no-regression", [&o] { o.bayes.distance_regression = false; },
                        "Ablation: no 1/d^2 distance regression (z = Y)")->group(bg);
   r->add_flag_callback("--bayes-naive", [&o] { o.bayes.prior = false; },

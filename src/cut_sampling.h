@@ -36,6 +36,9 @@ struct cut_context {
   bool cv = false;
   vec3f cv_sum = {0, 0, 0};
   float cvg[max_cut_entries + 3];
+  // The point factor of each cluster (bayes, region prior): 1 / d^2 times the receiver's cosine bound toward the
+  // cluster; 0 behind the surface. A sample z = Y / factor is what the pair's statistics learn.
+  float gfac[max_cut_entries + 3];
   // Recording cache (bayes): the row-state accumulator of each cluster of the current region, valid while the
   // same row state (and generation of it) and region are recorded into; -1: not looked up yet.
   mutable const void* rec_owner = nullptr;

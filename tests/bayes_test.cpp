@@ -190,20 +190,39 @@ shade_point pixel_point(const test_scene& t, int x, int y) {
 // prior: the bound at the point and scale = albedo / pi (z = Y d^2). Region prior: bound = mu0_j g_j of the pair and
 // scale = 1 (z = (Y / (albedo / pi)) d^2). `prior_weight` is the prior-only weight the sampler mixes and falls back
 // to (the bound, or mu0 g), and `y_per_z` turns a z into the sample Y that records it.
+// The receiver orientation factor of cluster `node` at (p, n) in the region-prior mode (1 when the orientation
+// switch is off): (r - n.(p - c)) / |p - c| clamped to [1e-3, 1] for a tree node, the receiver cosine bound
+// toward the sun disk for the sun, computed here in double.
+double orientation_of(const test_scene& t, const bayes_sampler& s, int node, vec3f p, vec3f n) {
+  if (!s.params.region_prior || !s.params.orientation) return 1;
+  double o;
+  if (node == sun_cluster) {
+    o = receiver_cos_bound(n, t.lights.sun_dir, s.sun_sin, s.sun_cos);
+  } else {
+    vec3f c = t.tree.center[size_t(node)];
+    double r = t.tree.radius[size_t(node)];
+    double dn = double(n.x) * (p.x - c.x) + double(n.y) * (p.y - c.y) + double(n.z) * (p.z - c.z);
+    o = (r - dn) / std::sqrt(double(length_sq(p - c)));
+  }
+  return std::min(1.0, std::max(o, 1e-3));
+}
+
+// o: the orientation factor; the sample Y records z = Y d^2 / o (z = Y / o without the regression).
 struct prior_args {
-  double bound, scale, d, prior_weight, y_per_z;
+  double bound, scale, d, prior_weight, y_per_z, o;
 };
 prior_args prior_of(const test_scene& t, const bayes_sampler& s, const cut_context& ctx, int j, const shade_point& pt) {
   prior_args a;
   double point_scale = pt.albedo * inv_pi_f;
   a.d = cluster_distance(t.tree, ctx.nodes[j], pt.p);
+  a.o = orientation_of(t, s, ctx.nodes[j], pt.p, pt.n);
   if (s.params.region_prior) {
-    // Without the regression the sampler's weight is W itself (no g), and mu0 is a mean of Y / (albedo / pi).
+    // Without the regression the sampler's weight is W o (no g), and mu0 is a mean of Y / (albedo / pi) / o.
     double g = 1 / (a.d * a.d);
-    a.bound = double(s.stats.mu0[size_t(ctx.pair_base + j)]) * (s.params.distance_regression ? g : 1.0);
+    a.bound = double(s.stats.mu0[size_t(ctx.pair_base + j)]) * (s.params.distance_regression ? g : 1.0) * a.o;
     a.scale = 1;
     a.prior_weight = a.bound;
-    a.y_per_z = point_scale * g;
+    a.y_per_z = point_scale * g * a.o;
   } else {
     float inv_d2;
     float num = cluster_bound_parts(t.tree, t.lights, ctx.nodes[j], pt.p, pt.n, 0, 1, inv_d2);
@@ -367,7 +386,7 @@ TEST_CASE("a bayes sampler without data picks clusters like the bound sampler", 
 }
 
 TEST_CASE("with the region prior a bayes sampler without data weighs clusters by mu0 over d^2", "[bayes]") {
-  // Prior only: w_j = const * mu0_j g_j, with mu0_j the distance-free region bound of the cluster over the padded
+  // Prior only: w_j = const * mu0_j g_j o_j (o_j the orientation factor, orientation_of), with mu0_j the distance-free region bound of the cluster over the padded
   // region box (the sun: its irradiance), g_j = 1 / max(|p - c_j|^2, r_j^2), and w_j = 0 exactly when the cluster's
   // bounding sphere lies behind the point's surface.
   for (bool sun : {true, false}) {
@@ -407,7 +426,10 @@ TEST_CASE("with the region prior a bayes sampler without data weighs clusters by
           front = dot(n, c - p) > -r;
         }
         CHECK(double(sy.stats.mu0[size_t(cy->pair_base + j)]) == mu0);
-        w[j] = front ? mu0 * g : 0;
+        w[j] = front ? mu0 * g * orientation_of(*t, sy, node, p, n) : 0;
+        // The point factor the sampler records with (z = Y / factor): g o in front, 0 behind.
+        double factor = front ? g * orientation_of(*t, sy, node, p, n) : 0;
+        CHECK(std::fabs(double(cy->gfac[j]) - factor) <= 1e-5 * factor);
         (front ? in_front : behind)++;
         total += w[j];
       }
@@ -564,13 +586,14 @@ convergence_result run_convergence(const bayes_params& params, const convergence
   convergence_result r;
   // Region prior: the statistics hold the albedo-free z = (Y / (albedo / pi)) d^2.
   double y_scale = params.region_prior ? double(pt.albedo * inv_pi_f) : 1.0;
-  double d[3], k[3], h[3], dist[3], y_per_z[3];
+  double d[3], k[3], h[3], dist[3], y_per_z[3], o[3];
   for (int j = 0; j < 3; j++) {
     r.prior[j] = cluster_pmf(*ctx, j);
     prior_args a = prior_of(*t, s, *ctx, j, pt);
     dist[j] = cluster_distance(t->tree, ctx->nodes[j], pt.p);
     d[j] = dist[j];
-    double mu0 = a.scale * a.bound * d[j] * d[j];  // prior mean of z
+    o[j] = a.o;
+    double mu0 = a.scale * a.bound * d[j] * d[j] / o[j];  // prior mean of z
     k[j] = cs.factor[j] * mu0;
     h[j] = cs.cv[j] * cs.cv[j] * k[j] * k[j];
     y_per_z[j] = a.y_per_z;
@@ -594,7 +617,10 @@ convergence_result run_convergence(const bayes_params& params, const convergence
           // What the statistics must hold: z = Y d^2 with the regression, z = Y without (Y / (albedo / pi) with
           // the region prior).
           double yy = params.region_prior ? double(y) / y_scale : double(y);
-          double z = params.distance_regression ? yy * dist[j] * dist[j] : yy;
+          // With the region prior the sampler divides by its float point factor (checked against the double
+          // formula in the prior-only test), so the means agree to rounding.
+          double z = params.region_prior ? yy / double(ctx->gfac[j])
+                                         : (params.distance_regression ? yy * dist[j] * dist[j] : yy);
           zsum[size_t(j)] += z;
           zcount[size_t(j)] += 1;
         }
@@ -612,11 +638,11 @@ convergence_result run_convergence(const bayes_params& params, const convergence
     double ez2 = k2 + hh, ez4 = k2 * k2 + 6 * k2 * hh + 3 * hh * hh;  // moments of z given non-zero
     double f = cs.factor[j], n1 = n * p1;
     if (params.second_moment) {
-      r.target[j] = std::sqrt(p1 * ez2) / (d[j] * d[j]);
+      r.target[j] = std::sqrt(p1 * ez2) / (d[j] * d[j]) * o[j];
       // w^2 estimates E[Z^2], Z = z 1{non-zero}: relative sd of w = sd(Z^2) / E[Z^2] / (2 sqrt(n)).
       sigma = std::max(sigma, 0.5 * std::sqrt((ez4 / (p1 * ez2 * ez2) - 1) / n));
     } else {
-      r.target[j] = p1 * k[j] / (d[j] * d[j]);
+      r.target[j] = p1 * k[j] / (d[j] * d[j]) * o[j];
       sigma = std::max(sigma, std::sqrt((ez2 / (p1 * k2) - 1) / n));
     }
     // Pull of the prior, relative, of order 1 / n1 (see METHOD.md 4): Beta pseudo-counts, kappa0 on the mean,
@@ -722,7 +748,7 @@ TEST_CASE("the naive ablation follows plug in moments exactly", "[bayes]") {
       if (j == 0) {
         std::vector<double> z = {0.5 / a.y_per_z, 0.25 / a.y_per_z};
         double mean = (z[0] + z[1]) / 2, var = ((z[0] - mean) * (z[0] - mean) + (z[1] - mean) * (z[1] - mean)) / 2;
-        w[j] = std::sqrt(0.5 * (mean * mean + var)) / (a.d * a.d);
+        w[j] = std::sqrt(0.5 * (mean * mean + var)) / (a.d * a.d) * a.o;
       } else if (j == 1) {
         w[j] = 0;  // only zeros: the naive estimate starves the cluster (the mixing keeps it alive)
       } else {
@@ -794,10 +820,12 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     for (int j = 0; j < 3; j++) {
       size_t i = base + size_t(j), up = size_t(s.regions.pair_parent[i]);
       prior_args a = prior_of(*t, s, *ctx, j, pt);
-      double wf = posterior_weight(s.params, a.bound, a.scale, a.d, s.stats.m[i].n0, s.stats.m[i].n1, s.stats.m[i].mean,
-                                   s.stats.m[i].m2);
-      double wp = posterior_weight(s.params, a.bound, a.scale, a.d, s.stats.m[up].n0, s.stats.m[up].n1, s.stats.m[up].mean,
-                                   s.stats.m[up].m2);
+      // posterior_weight models the point factor 1 / d^2: the orientation factor o scales the prior mean of z by
+      // 1 / o and the weight by o.
+      double wf = a.o * posterior_weight(s.params, a.bound / a.o, a.scale, a.d, s.stats.m[i].n0, s.stats.m[i].n1,
+                                         s.stats.m[i].mean, s.stats.m[i].m2);
+      double wp = a.o * posterior_weight(s.params, a.bound / a.o, a.scale, a.d, s.stats.m[up].n0, s.stats.m[up].n1,
+                                         s.stats.m[up].mean, s.stats.m[up].m2);
       const bayes_params& bp = s.params;
       double n = s.stats.m[i].n0 + s.stats.m[i].n1, np = s.stats.m[up].n0 + s.stats.m[up].n1;
       double p1_own = (bp.b0 + s.stats.m[i].n1) / (bp.a0 + bp.b0 + n);
@@ -858,7 +886,9 @@ TEST_CASE("control variates apply at unweighted NEE to nearly always visible clu
     vec3f cv_sum = {0, 0, 0};
     for (int j = 0; j < 3; j++) {
       size_t i = size_t(ctx->pair_base + j);
-      double d = cluster_distance(t->tree, ctx->nodes[j], pt.p), g = 1 / (d * d);
+      // g: the point factor, 1 / d^2 times the orientation factor.
+      double d = cluster_distance(t->tree, ctx->nodes[j], pt.p);
+      double g = orientation_of(*t, s, ctx->nodes[j], pt.p, pt.n) / (d * d);
       double p1 = pair_p1(s.stats, i, s.regions.pair_parent[i], s.params), k, h;
       bool learned = pair_posterior(s.stats, i, s.params, s.stats.mu0[i], k, h);
       bool cv = last && j == 0;

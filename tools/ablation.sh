@@ -11,6 +11,8 @@ SCENES=${SCENES:-"living_room plant_room hall"}
 variants=(
   "defaults|"
   "point prior (bound at every point)|--bayes-prior point"
+  "no orientation factor (1/d^2 only)|--bayes-no-orientation"
+  "equal pass weights|--pass-weighting 0"
   "no control variates|--bayes-no-cv"
   "mean PMF (no second moment)|--bayes-pmf mean"
   "no distance regression|--bayes-no-regression"
