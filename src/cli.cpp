@@ -25,8 +25,10 @@
 #include <cctype>
 #include <chrono>
 #include <climits>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -244,11 +246,21 @@ int run_diff(const diff_options& o) {
 }
 
 // The options `render` and `compare` share: spp or time, size, depth, threads, seed, quiet, sampler options.
+// Rejects NaN and infinities: CLI::Range and CLI::PositiveNumber let NaN through (every comparison with it is false).
+const CLI::Validator finite_number(
+    [](std::string& text) -> std::string {
+      char* end = nullptr;
+      double v = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || !std::isfinite(v)) return "Value " + text + " is not a finite number";
+      return {};
+    },
+    "");
+
 void add_render_options(CLI::App* r, render_options& o) {
   auto* spp = r->add_option("--spp", o.spp, "Samples per pixel (default: the scene's render.spp)")
                   ->check(CLI::Range(1, INT_MAX));
   auto* time = r->add_option("--time", o.time, "Render whole passes until this many seconds are spent")
-                   ->check(CLI::Range(1e-6, 1e9));
+                   ->check(CLI::Range(1e-6, 1e9))->check(finite_number);
   spp->excludes(time);
   r->add_option("--max-depth", o.max_depth, "Path length in bounces; 1 = direct illumination only")
       ->check(CLI::Range(1, 1000));
@@ -263,7 +275,7 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "Adaptive samplers (bayes, donikian): a pass after n spp counts (n+1)/(n+1+S) per sample, so the first "
                 "passes, taken before much is learned, weigh less; fixed in advance, so the image stays unbiased "
                 "(default 4; 0: all samples alike)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(CLI::Range(0.0, 1e9))->check(finite_number);
   // Regions, cuts and the ablation switches of the adaptive samplers.
   const char* grp = "Regions and light cuts (bound, bayes)";
   r->add_option("--grid", o.regions.grid, "Region cells along the shortest axis of the scene bounds (default 64)")
@@ -272,7 +284,7 @@ void add_render_options(CLI::App* r, render_options& o) {
       ->check(CLI::Range(1, 1024))->group(grp);
   r->add_option("--cut-coherence", o.regions.coherence,
                 "Keep a light cluster whole when its radius / gap to the region <= this (default 0.25; 0 = off)")
-      ->check(CLI::Range(0.0, 100.0))->group(grp);
+      ->check(CLI::Range(0.0, 100.0))->check(finite_number)->group(grp);
   r->add_option("--fine-depth", o.regions.fine_depth,
                 "Path vertices up to this depth use fine regions, deeper ones coarse regions (default 1)")
       ->check(CLI::Range(1, 1000))->group(grp);
@@ -293,7 +305,7 @@ void add_render_options(CLI::App* r, render_options& o) {
                        "Ablation: no control variates (with the region prior they apply where NEE is unweighted)")->group(bg);
   r->add_option("--bayes-cv-min-visible", o.bayes.cv_min_visible,
                 "Control variates only for clusters a region sees with probability at least this (default 0.98)")
-      ->check(CLI::Range(0.0, 1.0))->group(bg);
+      ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
   r->add_flag_callback("--bayes-no-orientation", [&o] { o.bayes.orientation = false; },
                        "Ablation: a point scales a cluster's weight by 1/d^2 only, not also by the receiver cosine bound")
       ->group(bg);
@@ -302,23 +314,23 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_flag_callback("--bayes-naive", [&o] { o.bayes.prior = false; },
                        "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method)")->group(bg);
   r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the prior-only (bound) PMF, in [0, 1] (default 0)")
-      ->check(CLI::Range(0.0, 1.0))->group(bg);
+      ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
   r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (> 0, default 1)")
-      ->check(CLI::PositiveNumber)->group(bg);
+      ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
   r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (> 0, default 0.03)")
-      ->check(CLI::PositiveNumber)->group(bg);
+      ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
   r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (> 0, default 1)")
-      ->check(CLI::PositiveNumber)->group(bg);
+      ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
   r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1, default 2)")
-      ->check(CLI::Range(1.000001, 1e9))->group(bg);
+      ->check(CLI::Range(1.000001, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-oracle", o.bayes.oracle_spp,
                 "Oracle mode: learn for this many spp first (own seed, not timed), then freeze the statistics")
       ->check(CLI::Range(0, 1 << 30))->group(bg);
   r->add_option("--bayes-hierarchy", o.bayes.hierarchy,
                 "Concentration of a fine region's Beta prior on p0, centred on its coarse parent's posterior (0 = off, default 1)")
-      ->check(CLI::Range(0.0, 1e9))->group(bg);
+      ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0, default 0.3)")
-      ->check(CLI::PositiveNumber)->group(bg);
+      ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
 }
 
 void add_render_command(CLI::App& app, render_options& o) {
@@ -336,7 +348,7 @@ void add_render_command(CLI::App& app, render_options& o) {
                 "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
                 "and at the end); --resume continues it");
   r->add_option("--checkpoint-every", o.checkpoint_every, "Seconds between checkpoints (default 30; 0: every pass)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(CLI::Range(0.0, 1e9))->check(finite_number);
   r->add_option("--resume", o.resume,
                 "Continue the render saved in FILE (same scene and options; --spp may be larger: the same bytes as one render "
                 "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...)");
@@ -346,7 +358,7 @@ void add_render_command(CLI::App& app, render_options& o) {
       ->group("");
   r->add_option("--frame-decay", o.frame_decay,
                 "Animations: learned statistics are scaled by this at each new frame (default 0.5; 1 keeps all)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(CLI::Range(0.0, 1.0))->check(finite_number);
   add_render_options(r, o);
 }
 

@@ -106,6 +106,16 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --width 60000 --height 60000", "too large"},
       {"render " + s.json + " -o " + (s.dir / "out.jpg"), "unknown image format"},
       {"render " + s.json + " --bogus", "--bogus"},
+      // NaN passes every range comparison: each real-valued option rejects it (and infinities) itself.
+      {"render " + s.json + " --time nan", "--time"},
+      {"render " + s.json + " --pass-weighting nan", "--pass-weighting"},
+      {"render " + s.json + " --cut-coherence nan", "--cut-coherence"},
+      {"render " + s.json + " --bayes-epsilon nan", "--bayes-epsilon"},
+      {"render " + s.json + " --bayes-c nan", "--bayes-c"},
+      {"render " + s.json + " --bayes-a0 inf", "--bayes-a0"},
+      {"render " + s.json + " --bayes-alpha0 nan", "--bayes-alpha0"},
+      {"render " + s.json + " --frame-decay nan", "--frame-decay"},
+      {"render " + s.json + " --checkpoint-every nan", "--checkpoint-every"},
       {"frobnicate", "frobnicate"},
   };
   for (const auto& c : cases) {
