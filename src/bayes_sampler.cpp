@@ -181,8 +181,7 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   if (z > 0) {
     if (params.region_prior) {
       // The albedo-free sample (see bayes_stats) over the point factor the pmf used: z = Y d^2 / cos bound.
-      z /= point_scale(ctx.albedo);
-      if (params.distance_regression || params.orientation) z /= double(ctx.gfac[j]);
+      z = z / point_scale(ctx.albedo) / double(ctx.gfac[j]);
     } else if (params.distance_regression) {
       double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
       z *= d * d;

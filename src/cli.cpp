@@ -245,7 +245,6 @@ int run_diff(const diff_options& o) {
   return exit_ok;
 }
 
-// The options `render` and `compare` share: spp or time, size, depth, threads, seed, quiet, sampler options.
 // Rejects NaN and infinities: CLI::Range and CLI::PositiveNumber let NaN through (every comparison with it is false).
 const CLI::Validator finite_number(
     [](std::string& text) -> std::string {
@@ -256,6 +255,7 @@ const CLI::Validator finite_number(
     },
     "");
 
+// The options `render` and `compare` share: spp or time, size, depth, threads, seed, quiet, sampler options.
 void add_render_options(CLI::App* r, render_options& o) {
   auto* spp = r->add_option("--spp", o.spp, "Samples per pixel (default: the scene's render.spp)")
                   ->check(CLI::Range(1, INT_MAX));

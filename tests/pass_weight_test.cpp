@@ -25,18 +25,9 @@ struct built_scene {
   light_data lights;
 };
 
-// The floor beside a closed box that holds a bright lamp, lit only by a dim lamp outside: the bound prior sends
-// most NEE samples to the shut-in lamp until learning moves them.
+// The boxed lamp of test_util.h: the bound prior sends most NEE samples to the shut-in lamp until learning moves
+// them.
 std::unique_ptr<built_scene> boxed_lamp_scene() {
-  mesh_builder m;
-  int floor = m.add_material({0.5f, 0.5f, 0.5f});
-  int box = m.add_material({0.6f, 0.6f, 0.6f});
-  int bright = m.add_material({0, 0, 0}, {200, 200, 200});
-  int dim = m.add_material({0, 0, 0}, {1, 1, 1});
-  m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
-  m.add_box({-0.5f, 0.01f, -0.5f}, {0.5f, 1, 0.5f}, box);
-  m.add_quad({-0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, 0.1f}, {-0.1f, 0.9f, 0.1f}, bright);
-  m.add_quad({1, 2, -0.25f}, {1.5f, 2, -0.25f}, {1.5f, 2, 0.25f}, {1, 2, 0.25f}, dim);
   camera_params cam;
   cam.automatic = false;
   cam.eye = {2, 4, 0.01f};
@@ -44,7 +35,7 @@ std::unique_ptr<built_scene> boxed_lamp_scene() {
   cam.up = {0, 0, -1};
   cam.fov_y_deg = 40;
   auto b = std::make_unique<built_scene>();
-  b->scene = build_scene(std::move(m.mesh), cam, {}, false, 1.0f);
+  b->scene = build_scene(boxed_lamp_mesh(), cam, {}, false, 1.0f);
   b->bvh = build_bvh(b->scene);
   b->lights = build_lights(b->scene);
   return b;

@@ -199,17 +199,8 @@ TEST_CASE("two lamps with a radiance ratio of 1e6 render consistently with every
 
 TEST_CASE("a bright lamp shut in a closed box next to a dim lamp renders consistently with every sampler",
           "[stiff]") {
-  mesh_builder m;
-  int floor = m.add_material({0.5f, 0.5f, 0.5f});
-  int box = m.add_material({0.6f, 0.6f, 0.6f});
-  int bright = m.add_material({0, 0, 0}, {200, 200, 200});
-  int dim = m.add_material({0, 0, 0}, {1, 1, 1});
-  m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
-  m.add_box({-0.5f, 0.01f, -0.5f}, {0.5f, 1, 0.5f}, box);
-  m.add_quad({-0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, 0.1f}, {-0.1f, 0.9f, 0.1f}, bright);  // inside
-  m.add_quad({1, 2, -0.25f}, {1.5f, 2, -0.25f}, {1.5f, 2, 0.25f}, {1, 2, 0.25f}, dim);
   // The camera sees the floor beside the box (and the box's outer wall), lit by the dim lamp only.
-  auto b = build(std::move(m.mesh), looking_down({2, 4, 0.01f}, {2, 0, 0}, 40));
+  auto b = build(boxed_lamp_mesh(), looking_down({2, 4, 0.01f}, {2, 0, 0}, 40));
   check_scene(*b, 1, 2048);
   check_scene(*b, 3, 1024);
   check_bayes_state(*b, 3);

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace bl::test {
@@ -172,5 +173,20 @@ struct mesh_builder {
     add_quad(p[2], p[6], p[7], p[3], material);  // +y
   }
 };
+
+// A floor beside a closed box that holds a bright lamp (Ke 200), lit only by a dim lamp (Ke 1) outside the box:
+// a bound-style prior sends most NEE samples to the shut-in lamp. Seen well from eye (2, 4, 0.01) looking down.
+inline mesh_data boxed_lamp_mesh() {
+  mesh_builder m;
+  int floor = m.add_material({0.5f, 0.5f, 0.5f});
+  int box = m.add_material({0.6f, 0.6f, 0.6f});
+  int bright = m.add_material({0, 0, 0}, {200, 200, 200});
+  int dim = m.add_material({0, 0, 0}, {1, 1, 1});
+  m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
+  m.add_box({-0.5f, 0.01f, -0.5f}, {0.5f, 1, 0.5f}, box);
+  m.add_quad({-0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, 0.1f}, {-0.1f, 0.9f, 0.1f}, bright);  // inside
+  m.add_quad({1, 2, -0.25f}, {1.5f, 2, -0.25f}, {1.5f, 2, 0.25f}, {1, 2, 0.25f}, dim);
+  return std::move(m.mesh);
+}
 
 }  // namespace bl::test
