@@ -109,6 +109,9 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
   const bool regression = params.distance_regression;
   const bool orientation = params.orientation;
+  const __m128 zero = _mm_setzero_ps();
+  int front_mask = 0;  // some cluster can reach the point
+  vec3f cv_sum = {0, 0, 0};
   for (int j0 = 0; j0 < tc; j0 += 4) {
     // (cx, cy, cz, r) of four nodes (missing lanes repeat the last node; their results are never read).
     __m128 c0 = _mm_loadu_ps(&tree->packed[size_t(ctx.nodes[std::min(j0 + 0, tc - 1)])].cx);
@@ -132,22 +135,35 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     g = _mm_and_ps(front, g);
     _mm_storeu_ps(gf + j0, g);
     _mm_store_ps(wf + j0, _mm_mul_ps(_mm_loadu_ps(W + j0), g));
-    if (ctx.cv) _mm_storeu_ps(ctx.cvg + j0, _mm_mul_ps(_mm_loadu_ps(stats.cv.data() + base + size_t(j0)), g));
+    const int lanes = tc - j0 >= 4 ? 0xf : (1 << (tc - j0)) - 1;  // the lanes of real clusters
+    front_mask |= _mm_movemask_ps(_mm_cmpgt_ps(g, zero)) & lanes;
+    if (ctx.cv) {
+      // c_j = (E[1 - p0] k_j) g_j, zero behind the surface like the weight, and their colour-weighted sum in
+      // cluster order (most pairs have no control variate: c_j = 0, skipped four at a time).
+      __m128 c = _mm_mul_ps(_mm_loadu_ps(stats.cv.data() + base + size_t(j0)), g);
+      _mm_storeu_ps(ctx.cvg + j0, c);
+      for (int m = _mm_movemask_ps(_mm_cmpneq_ps(c, zero)) & lanes; m != 0; m &= m - 1) {
+        int j = j0 + __builtin_ctz(unsigned(m));
+        cv_sum += cluster_color(ctx, j) * ctx.cvg[j];
+      }
+    }
   }
   if (tc < ctx.count) {
     float front = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
     float cos_bound = orientation ? receiver_cos_bound(sp.n, lights->sun_dir, sun_sin, sun_cos) : 1.0f;
     gf[tc] = front * std::min(1.0f, std::max(cos_bound, orientation_floor));
     wf[tc] = W[tc] * gf[tc];
+    front_mask |= gf[tc] > 0;
+    if (ctx.cv) {
+      ctx.cvg[tc] = stats.cv[base + size_t(tc)] * gf[tc];
+      if (ctx.cvg[tc] != 0) cv_sum += cluster_color(ctx, tc) * ctx.cvg[tc];
+    }
   }
-  if (ctx.cv) {
-    // c_j = (E[1 - p0] k_j) g_j (set above for tree clusters), zero behind the surface like the weight; their
-    // colour-weighted sum (most pairs have no control variate: c_j = 0).
-    if (tc < ctx.count) ctx.cvg[tc] = stats.cv[base + size_t(tc)] * gf[tc];
-    vec3f sum = {0, 0, 0};
-    for (int j = 0; j < ctx.count; j++)
-      if (ctx.cvg[j] != 0) sum += cluster_color(ctx, j) * ctx.cvg[j];
-    ctx.cv_sum = sum;
+  ctx.cv_sum = cv_sum;
+  if (front_mask == 0) {
+    // Every cluster lies behind the surface: no light can be sampled (what the fallbacks below would also find).
+    std::fill(ctx.cdf, ctx.cdf + ctx.count + 1, 0.0);
+    return;
   }
   alignas(16) double w[max_cut_entries + 3];
   for (int j = 0; j < ctx.count; j += 4) {  // to double, four at a time (wf has room for the padding lanes)

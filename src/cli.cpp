@@ -285,6 +285,10 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--cut-coherence", o.regions.coherence,
                 "Keep a light cluster whole when its radius / gap to the region <= this (default 0.25; 0 = off)")
       ->check(CLI::Range(0.0, 100.0))->check(finite_number)->group(grp);
+  r->add_option("--shared-cut-lights", o.regions.shared_cut_lights,
+                "Scenes with at most this many lights give every region a cut of all lights, no clustering (default 16; "
+                "0: always clustered cuts)")
+      ->check(CLI::Range(0, 1 << 30))->group(grp);
   r->add_option("--fine-depth", o.regions.fine_depth,
                 "Path vertices up to this depth use fine regions, deeper ones coarse regions (default 1)")
       ->check(CLI::Range(1, 1000))->group(grp);

@@ -2,6 +2,7 @@
 #include "cluster_bounds.h"
 
 #include <emmintrin.h>
+#include <xmmintrin.h>
 
 namespace bl {
 
@@ -18,21 +19,25 @@ inline __m128 safe_sqrt4(__m128 v) { return _mm_sqrt_ps(_mm_max_ps(v, _mm_setzer
 
 void eval_node_bounds(const light_tree_data& tree, const int* nodes, int count, vec3f p,
                       vec3f n, float* num, float* inv_d2) {
-  alignas(16) float f[10][4];
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), minus_one = _mm_set1_ps(-1.0f);
   const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
   const __m128 sign_mask = _mm_castsi128_ps(_mm_set1_epi32(int(0x80000000u)));
   for (int j0 = 0; j0 < count; j0 += 4) {
-    // Gather four nodes (missing lanes repeat the last node; their results are never read).
-    for (int k = 0; k < 4; k++) {
-      const node_pack& q = tree.packed[size_t(nodes[std::min(j0 + k, count - 1)])];
-      f[0][k] = q.cx, f[1][k] = q.cy, f[2][k] = q.cz, f[3][k] = q.r, f[4][k] = q.ax;
-      f[5][k] = q.ay, f[6][k] = q.az, f[7][k] = q.cos_o, f[8][k] = q.sin_o, f[9][k] = q.intensity;
-    }
-    __m128 tx = _mm_sub_ps(_mm_set1_ps(p.x), _mm_load_ps(f[0]));
-    __m128 ty = _mm_sub_ps(_mm_set1_ps(p.y), _mm_load_ps(f[1]));
-    __m128 tz = _mm_sub_ps(_mm_set1_ps(p.z), _mm_load_ps(f[2]));
-    __m128 r = _mm_load_ps(f[3]);
+    // Four nodes as three 4x4 transposes of their packs (missing lanes repeat the last node; their results are
+    // never read): rows (cx, cy, cz, r), (ax, ay, az, cos_o), (sin_o, intensity, pad, pad).
+    const float* q[4];
+    for (int k = 0; k < 4; k++) q[k] = &tree.packed[size_t(nodes[std::min(j0 + k, count - 1)])].cx;
+    __m128 cx = _mm_loadu_ps(q[0]), cy = _mm_loadu_ps(q[1]), cz = _mm_loadu_ps(q[2]), r = _mm_loadu_ps(q[3]);
+    _MM_TRANSPOSE4_PS(cx, cy, cz, r);
+    __m128 ax = _mm_loadu_ps(q[0] + 4), ay = _mm_loadu_ps(q[1] + 4), az = _mm_loadu_ps(q[2] + 4),
+           co = _mm_loadu_ps(q[3] + 4);
+    _MM_TRANSPOSE4_PS(ax, ay, az, co);
+    __m128 so = _mm_loadu_ps(q[0] + 8), inten = _mm_loadu_ps(q[1] + 8), p2 = _mm_loadu_ps(q[2] + 8),
+           p3 = _mm_loadu_ps(q[3] + 8);
+    _MM_TRANSPOSE4_PS(so, inten, p2, p3);
+    __m128 tx = _mm_sub_ps(_mm_set1_ps(p.x), cx);
+    __m128 ty = _mm_sub_ps(_mm_set1_ps(p.y), cy);
+    __m128 tz = _mm_sub_ps(_mm_set1_ps(p.z), cz);
     // d2 = (x*x + y*y) + z*z, as dot() evaluates it.
     __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, tx), _mm_mul_ps(ty, ty)), _mm_mul_ps(tz, tz));
     // max(d2, r*r): std::max(a, b) returns a unless a < b.
@@ -49,11 +54,9 @@ void eval_node_bounds(const light_tree_data& tree, const int* nodes, int count, 
     __m128 wy = select(pos, _mm_div_ps(ty, d), zero);
     __m128 wz = select(pos, _mm_div_ps(tz, d), one);
     // Emitter side.
-    __m128 cos_w = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(f[4]), wx), _mm_mul_ps(_mm_load_ps(f[5]), wy)),
-                              _mm_mul_ps(_mm_load_ps(f[6]), wz));
+    __m128 cos_w = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, wx), _mm_mul_ps(ay, wy)), _mm_mul_ps(az, wz));
     if (tree.two_sided) cos_w = _mm_and_ps(cos_w, abs_mask);
     __m128 sin_w = safe_sqrt4(_mm_sub_ps(one, _mm_mul_ps(cos_w, cos_w)));
-    __m128 co = _mm_load_ps(f[7]), so = _mm_load_ps(f[8]);
     __m128 inside_cone = _mm_cmpge_ps(cos_w, co);
     __m128 cos_wo = select(inside_cone, one, _mm_add_ps(_mm_mul_ps(cos_w, co), _mm_mul_ps(sin_w, so)));
     __m128 sin_wo = select(inside_cone, zero, _mm_sub_ps(_mm_mul_ps(sin_w, co), _mm_mul_ps(cos_w, so)));
@@ -67,7 +70,7 @@ void eval_node_bounds(const light_tree_data& tree, const int* nodes, int count, 
     __m128 sin_i = safe_sqrt4(_mm_sub_ps(one, _mm_mul_ps(cos_i, cos_i)));
     __m128 cr = select(_mm_cmpge_ps(cos_i, cos_b), one, _mm_add_ps(_mm_mul_ps(cos_i, cos_b), _mm_mul_ps(sin_i, sin_b)));
     cr = select(_mm_cmpgt_ps(cr, zero), cr, zero);
-    __m128 v = _mm_mul_ps(_mm_mul_ps(_mm_load_ps(f[9]), ce), cr);
+    __m128 v = _mm_mul_ps(_mm_mul_ps(inten, ce), cr);
     // A zero emitter bound gives exactly 0 (the scalar code returns before multiplying).
     _mm_storeu_ps(num + j0, select(_mm_cmpgt_ps(ce, zero), v, zero));
   }

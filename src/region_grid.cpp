@@ -143,9 +143,9 @@ uint64_t parent_region_key(const region_grid_data& g, uint64_t fine_key, int lev
   if (level >= 2) return make_key(2, 0, 0, 0);
   int i, j, k;
   key_cell(fine_key, i, j, k);
-  int f = level == 1 ? 8 : 1;
-  return make_key(level, std::min(i / f, g.dims[level][0] - 1), std::min(j / f, g.dims[level][1] - 1),
-                  std::min(k / f, g.dims[level][2] - 1));
+  int shift = level == 1 ? 3 : 0;  // coarse cells are 8 fine cells (i, j, k >= 0: a shift is the division)
+  return make_key(level, std::min(i >> shift, g.dims[level][0] - 1), std::min(j >> shift, g.dims[level][1] - 1),
+                  std::min(k >> shift, g.dims[level][2] - 1));
 }
 
 bbox3f region_box(const region_grid_data& g, uint64_t key) {

@@ -106,6 +106,7 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --width 60000 --height 60000", "too large"},
       {"render " + s.json + " -o " + (s.dir / "out.jpg"), "unknown image format"},
       {"render " + s.json + " --bogus", "--bogus"},
+      {"render " + s.json + " --shared-cut-lights -1", "--shared-cut-lights"},
       // NaN passes every range comparison: each real-valued option rejects it (and infinities) itself.
       {"render " + s.json + " --time nan", "--time"},
       {"render " + s.json + " --pass-weighting nan", "--pass-weighting"},
