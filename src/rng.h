@@ -25,7 +25,8 @@ enum rng_dim : int {
   dim_roulette = 7,      // Russian roulette
   dim_light_select_lo = 8,  // low bits of the two light choices (they use 53-bit uniforms, see u53)
   dim_light_inner_lo = 9,
-  dims_per_vertex = 10
+  dims_per_vertex = 10,
+  camera_dims = 2           // the camera vertex uses only the pixel jitter
 };
 
 // One vertex's uniforms in [0, 1) (24-bit floats) and the raw draws behind them.
@@ -56,11 +57,12 @@ inline uint64_t sample_key(uint64_t seed, uint64_t pixel, uint64_t sample) {
 // Uniform float in [0, 1) from the top 24 bits of a 32-bit draw (exactly representable).
 inline float uint_to_unit(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
 
-// The block of uniforms of path vertex `vertex` (0 = camera) of the sample with key `key`.
-inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex) {
+// The block of uniforms of path vertex `vertex` (0 = camera) of the sample with key `key`: its first `count`
+// dimensions (the same values as the whole block's; the rest are left unset), e.g. 2 for the camera vertex.
+inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex, int count = dims_per_vertex) {
   pcg32 rng(key, vertex);
   vertex_randoms r;
-  for (int i = 0; i < dims_per_vertex; i++) {
+  for (int i = 0; i < count; i++) {
     r.raw[i] = rng();
     r.u[i] = uint_to_unit(r.raw[i]);
   }
