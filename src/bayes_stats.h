@@ -17,8 +17,9 @@ namespace bl {
 
 // Prior strengths and ablation switches.
 struct bayes_params {
-  double a0 = 1, b0 = 0.03;      // Beta prior of the zero-sample probability p0 (b0 << a0: a cluster is believed
-                                 // mostly occluded until it shows non-zero samples; see README, choosing the defaults)
+  double a0 = 0.3, b0 = 0.03;    // Beta prior of the zero-sample probability p0 (b0 << a0: a cluster is believed
+                                 // mostly occluded until it shows non-zero samples; a0 + b0 << 1: its own first
+                                 // samples outweigh that belief; see README, choosing the defaults)
   double kappa0 = 1;             // prior pseudo-count of the mean
   double alpha0 = 2;             // inverse-gamma shape (> 1)
   double c = 0.3;                // prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1)

@@ -319,7 +319,7 @@ void add_render_options(CLI::App* r, render_options& o) {
                        "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method)")->group(bg);
   r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the prior-only (bound) PMF, in [0, 1] (default 0)")
       ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
-  r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (> 0, default 1)")
+  r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (> 0, default 0.3)")
       ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
   r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (> 0, default 0.03)")
       ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);

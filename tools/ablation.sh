@@ -18,10 +18,11 @@ variants=(
   "no distance regression|--bayes-no-regression"
   "naive (no prior, plug-in moments)|--bayes-naive"
   "epsilon 0.05 (prior mixing)|--bayes-epsilon 0.05"
-  "Beta(1, 1) on p0 (b0 1)|--bayes-b0 1"
+  "Beta(1, 0.03) on p0 (a0 1: the last defaults)|--bayes-a0 1"
+  "Beta(1, 1) on p0|--bayes-a0 1 --bayes-b0 1"
   "no hierarchy|--bayes-hierarchy 0"
   "c 1 (prior CV 100%)|--bayes-c 1"
-  "previous defaults (b0 1, c 1, hier. 4)|--bayes-b0 1 --bayes-c 1 --bayes-hierarchy 4"
+  "earlier defaults (a0 1, b0 1, c 1, hier. 4)|--bayes-a0 1 --bayes-b0 1 --bayes-c 1 --bayes-hierarchy 4"
   "max cut 256|--max-cut 256"
   "bound sampler (reference point)|--sampler bound"
 )
