@@ -16,6 +16,14 @@ inline double floored(double w, double floor) {
   return _mm_cvtsd_f64(_mm_and_pd(_mm_max_sd(x, _mm_set_sd(floor)), positive));
 }
 
+// c[j] = (c[j] + off) * inv for j < n, two at a time (the same IEEE operations as the scalar form; x + 0 == x).
+inline void scale_cdf(double* c, int n, double off, double inv) {
+  const __m128d o = _mm_set1_pd(off), s = _mm_set1_pd(inv);
+  int j = 0;
+  for (; j + 2 <= n; j += 2) _mm_storeu_pd(c + j, _mm_mul_pd(_mm_add_pd(_mm_loadu_pd(c + j), o), s));
+  if (j < n) c[j] = (c[j] + off) * inv;
+}
+
 }  // namespace
 
 bool fill_cdf(const double* w, int n, double* cdf) {
@@ -37,54 +45,40 @@ bool fill_cdf(const double* w, int n, double* cdf) {
   // Floor every positive weight so that no item that can contribute rounds to probability zero (written without
   // branches: zero weights come in unpredictable patterns).
   const double floor = total * min_positive_share;
+  // Running sums: short cdfs (most cuts) in one chain, longer ones over four quarters [0, q), [q, 2q), [2q, 3q) (full:
+  // 3q <= n for n >= 9) and the rest, each quarter then shifted by the sum of the quarters before it.
   if (n < 9) {
-    // Short cdfs (most cuts): one running sum, then the scale (x + 0 == x: the same values as the general path).
     double a = 0;
     for (int k = 0; k < n; k++) cdf[k + 1] = a += floored(w[k], floor);
-    const double inv = 1 / a;
-    const __m128d inv2 = _mm_set1_pd(inv);
-    int k = 1;
-    for (; k + 2 <= n + 1; k += 2) _mm_storeu_pd(cdf + k, _mm_mul_pd(_mm_loadu_pd(cdf + k), inv2));
-    if (k <= n) cdf[k] *= inv;
-    int last = n - 1;
-    while (!(w[last] > 0)) last--;  // some weight is positive (total > 0)
-    for (int k = last; k < n; k++) cdf[k + 1] = 1.0;  // exact end point
-    return true;
-  }
-  // Longer ones: quarters [0, q), [q, 2q), [2q, 3q) are full (3q <= n for n >= 9), the last one holds the rest.
-  const int q = (n + 3) / 4;
-  const int tail = n - 3 * q;
-  double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
-  const double* w1 = w + q;
-  const double* w2 = w + 2 * q;
-  const double* w3 = w + 3 * q;
-  double* c0 = cdf + 1;
-  double* c1 = cdf + 1 + q;
-  double* c2 = cdf + 1 + 2 * q;
-  double* c3 = cdf + 1 + 3 * q;
-  for (int k = 0; k < tail; k++) {
-    c0[k] = a0 += floored(w[k], floor);
-    c1[k] = a1 += floored(w1[k], floor);
-    c2[k] = a2 += floored(w2[k], floor);
-    c3[k] = a3 += floored(w3[k], floor);
-  }
-  for (int k = tail; k < q; k++) {
-    c0[k] = a0 += floored(w[k], floor);
-    c1[k] = a1 += floored(w1[k], floor);
-    c2[k] = a2 += floored(w2[k], floor);
-  }
-  const double off[4] = {0, a0, a1 + a0, a2 + (a1 + a0)};
-  const int starts[5] = {0, q, 2 * q, 3 * q, n};
-  total = a3 + off[3];
-  const double inv = 1 / total;
-  const __m128d inv2 = _mm_set1_pd(inv);
-  for (int l = 0; l < 4; l++) {
-    // (cdf + off) * inv, two at a time (the same IEEE operations as the scalar form).
-    const __m128d o = _mm_set1_pd(off[l]);
-    int j = starts[l];
-    for (; j + 2 <= starts[l + 1]; j += 2)
-      _mm_storeu_pd(cdf + j + 1, _mm_mul_pd(_mm_add_pd(_mm_loadu_pd(cdf + j + 1), o), inv2));
-    for (; j < starts[l + 1]; j++) cdf[j + 1] = (cdf[j + 1] + off[l]) * inv;
+    scale_cdf(cdf + 1, n, 0.0, 1 / a);
+  } else {
+    const int q = (n + 3) / 4;
+    const int tail = n - 3 * q;
+    double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+    const double* w1 = w + q;
+    const double* w2 = w + 2 * q;
+    const double* w3 = w + 3 * q;
+    double* c0 = cdf + 1;
+    double* c1 = cdf + 1 + q;
+    double* c2 = cdf + 1 + 2 * q;
+    double* c3 = cdf + 1 + 3 * q;
+    for (int k = 0; k < tail; k++) {
+      c0[k] = a0 += floored(w[k], floor);
+      c1[k] = a1 += floored(w1[k], floor);
+      c2[k] = a2 += floored(w2[k], floor);
+      c3[k] = a3 += floored(w3[k], floor);
+    }
+    for (int k = tail; k < q; k++) {
+      c0[k] = a0 += floored(w[k], floor);
+      c1[k] = a1 += floored(w1[k], floor);
+      c2[k] = a2 += floored(w2[k], floor);
+    }
+    const double off1 = a0, off2 = a1 + off1, off3 = a2 + off2;
+    const double inv = 1 / (a3 + off3);
+    scale_cdf(c0, q, 0.0, inv);
+    scale_cdf(c1, q, off1, inv);
+    scale_cdf(c2, q, off2, inv);
+    scale_cdf(c3, tail, off3, inv);
   }
   int last = n - 1;
   while (last >= 0 && !(w[last] > 0)) last--;
