@@ -313,9 +313,14 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
   // the tolerance from its exact value (which it gets whenever it is touched itself). Below p1_floor the tolerance
   // is absolute (tol * p1_floor): a cluster the region nearly never sees keeps a small weight either way. The
   // decisions depend on the statistics only: deterministic. Work: the touched pairs and the moved ones' children.
+  // Under the mean hierarchy a coarse pair's children are also refolded when its posterior mean k moved by more than
+  // the tolerance (relative) since they were last examined for it; only the children whose own bound lies above the
+  // lower of the two means (the others' prior mean is their bound either way).
   const double tol = params.refold_tolerance;
+  const bool means = hier && uses_mean_hierarchy(params);
   constexpr double p1_floor = 0.1;
   auto moved_by = [&](double now, double then) { return std::fabs(now - then) > tol * std::max(then, p1_floor); };
+  constexpr uint8_t p1_moved = 1, mean_moved = 2;
   std::vector<uint8_t>& moved = stats.scratch.seen;  // all zero between uses; sized for the old pairs
   // Touched pairs (their own statistics changed), flagging the coarse ones that moved.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& g) {
@@ -323,10 +328,15 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
       size_t k = size_t(touched[t]);
       fold(k);
       if (!hier || first_child[k] == invalid_id) continue;  // no children (a fine pair, or none created yet)
+      uint8_t flags = 0;
       float now = stats.coeffs[k].p1;
-      if (!moved_by(now, stats.p1_folded[k])) continue;
-      stats.p1_folded[k] = now;
-      moved[k] = 1;
+      if (moved_by(now, stats.p1_folded[k])) {
+        stats.p1_folded[k] = now;
+        flags |= p1_moved;
+      }
+      if (means && std::fabs(own_posterior_mean(stats, k, params) - stats.k_folded[k]) > tol * stats.k_folded[k])
+        flags |= mean_moved;
+      moved[k] = flags;
     }
     folds.fetch_add(int64_t(g.size()), std::memory_order_relaxed);
   });
@@ -335,7 +345,10 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
   tbb::parallel_for(tbb::blocked_range<size_t>(old_pairs, pairs, 1024), [&](const tbb::blocked_range<size_t>& g) {
     for (size_t i = g.begin(); i < g.end(); i++) {
       fold(i);
-      if (regions.pair_parent[i] == invalid_id) stats.p1_folded[i] = stats.coeffs[i].p1;
+      if (regions.pair_parent[i] == invalid_id) {
+        stats.p1_folded[i] = stats.coeffs[i].p1;
+        stats.k_folded[i] = float(own_posterior_mean(stats, i, params));
+      }
     }
     folds.fetch_add(int64_t(g.size()), std::memory_order_relaxed);
   });
@@ -345,10 +358,19 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
       int64_t count = 0;
       for (size_t t = g.begin(); t < g.end(); t++) {
         int k = touched[t];
-        if (!moved[size_t(k)]) continue;
+        uint8_t flags = moved[size_t(k)];
+        if (!flags) continue;
         moved[size_t(k)] = 0;
+        float low = 0;  // children whose bound lies above it may change their prior mean
+        if (flags & mean_moved) {
+          float now = float(own_posterior_mean(stats, size_t(k), params));
+          low = std::min(now, stats.k_folded[size_t(k)]);
+          stats.k_folded[size_t(k)] = now;
+        }
         for (int c = first_child[size_t(k)]; c != invalid_id; c = next_sibling[size_t(c)])
-          if (moved_by(pair_p1(stats, size_t(c), k, params), stats.p1_folded[size_t(c)])) fold(size_t(c)), count++;
+          if (((flags & mean_moved) && stats.mu0[size_t(c)] > low) ||
+              ((flags & p1_moved) && moved_by(pair_p1(stats, size_t(c), k, params), stats.p1_folded[size_t(c)])))
+            fold(size_t(c)), count++;
       }
       folds.fetch_add(count, std::memory_order_relaxed);
     });

@@ -34,6 +34,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
     }
   }
   s.p1_folded.resize(n, s.coeffs.empty() ? 1.0f : s.coeffs[n - 1].p1);
+  s.k_folded.resize(n, 0.0f);  // a parentless pair's is set by bayes_sampler::refold and refresh_weights
 }
 
 void decay_stats(bayes_stats& s, double gamma, const bayes_params& p) {
@@ -148,7 +149,10 @@ void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const baye
     for (size_t i = r.begin(); i < r.end(); i++) {
       int up = parents ? (*parents)[i] : invalid_id;
       fold_weight(s, i, up, p);
-      if (up < 0) s.p1_folded[i] = s.coeffs[i].p1;
+      if (up < 0) {
+        s.p1_folded[i] = s.coeffs[i].p1;
+        s.k_folded[i] = float(own_posterior_mean(s, i, p));
+      }
     }
   });
 }

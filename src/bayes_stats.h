@@ -42,6 +42,9 @@ struct bayes_params {
   bool orientation = true;       // region prior: the point factor of a cluster is its receiver cosine bound / d^2
                                  // (z = Y d^2 / cos), not 1 / d^2 alone: the regression also learns what the
                                  // orientation of the point explains
+  bool mean_hierarchy = true;    // region prior with the hierarchy: a fine pair's prior mean of z is the lower of its
+                                 // bound mu0 and its coarse parent's posterior mean (which pools the samples of all
+                                 // its fine regions), so a new fine region starts from what its surroundings learned
   bool control_variate = true;   // region prior only: where NEE is unweighted (direct illumination, the last path
                                  // vertex), add the learned mean c_j = E[1 - p0] k_j / d^2 of every cluster and
                                  // estimate the residual (Y_J - c_J) / P_J, with P_j proportional to the root of the
@@ -89,6 +92,8 @@ struct bayes_stats {
   std::vector<float> w_cv, cv;           // control variates: W of the residual, and E[1 - p0] k (+ 4 padding each)
   std::vector<float> p1_folded;          // hierarchy, per pair: a parent's p1 when its children were last examined;
                                          // a child's p1 folded into its weight
+  std::vector<float> k_folded;           // mean hierarchy, per parent pair: its posterior mean when its children were
+                                         // last examined for it
   merge_buffers scratch;
 };
 
@@ -108,7 +113,24 @@ inline double pair_p1(const bayes_stats& s, size_t i, int up, const bayes_params
   if (up < 0 || !(p.hierarchy > 0) || !p.prior) return s.coeffs[i].p1;
   return (p.hierarchy * double(s.coeffs[size_t(up)].p1) + s.m[i].n1) / (p.hierarchy + s.m[i].n0 + s.m[i].n1);
 }
-// Folds pair i's p1 into its sampling weight.
+// Posterior mean of z of pair i under its own prior mean mu0 (what its fine children may start from).
+inline double own_posterior_mean(const bayes_stats& s, size_t i, const bayes_params& p) {
+  const pair_moments& m = s.m[i];
+  return (p.kappa0 * double(s.mu0[i]) + m.n1 * m.mean) / (p.kappa0 + m.n1);
+}
+// Whether fine pairs take their prior mean from their coarse parents (region prior, hierarchy on, Bayesian prior).
+inline bool uses_mean_hierarchy(const bayes_params& p) {
+  return p.mean_hierarchy && p.region_prior && p.hierarchy > 0 && p.prior;
+}
+// Prior mean of z of pair i: its bound mu0, or under the mean hierarchy, for a fine pair (`up` its parent), the
+// parent's posterior mean where that is lower. The parent's bound covers a larger box (never below the child's),
+// so a parent without data changes nothing; the bound stays an upper limit of the prior mean.
+inline double prior_mean(const bayes_stats& s, size_t i, int up, const bayes_params& p) {
+  double mu0 = s.mu0[i];
+  if (up < 0 || !uses_mean_hierarchy(p)) return mu0;
+  return std::min(mu0, own_posterior_mean(s, size_t(up), p));
+}
+// Folds pair i's p1 (and, under the mean hierarchy, its parent's mean) into its sampling weight.
 inline double eval_weight(const pair_weight& h, const bayes_params& p, double v, double g);
 inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
   double p1 = pair_p1(s, i, up, p);
@@ -118,12 +140,13 @@ inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p)
   s.weight[i] = pw;  // read by every shading point in point-prior mode (and by the tests)
   if (!p.region_prior) return;
   // With v = mu0 g the weight is g times its value at g = 1 (see pair_coeffs): W = eval_weight(v = mu0, g = 1).
-  s.w[i] = float(eval_weight(pw, p, s.mu0[i], 1.0));
+  double mu0 = prior_mean(s, i, up, p);
+  s.w[i] = float(eval_weight(pw, p, mu0, 1.0));
   if (!p.control_variate) return;
   double k, h;
   // Only for clusters the region nearly always sees: where visibility is mixed it is usually a function of
   // position (a shadow edge through the region), and a region-wide mean would add, not remove, variance.
-  if (!p.second_moment || p1 < p.cv_min_visible || !pair_posterior(s, i, p, s.mu0[i], k, h)) {
+  if (!p.second_moment || p1 < p.cv_min_visible || !pair_posterior(s, i, p, mu0, k, h)) {
     s.w_cv[i] = s.w[i];  // no learned mean (or the mean-only ablation): the plain weight, no control variate
     s.cv[i] = 0;
     return;

@@ -15,7 +15,8 @@ namespace bl {
 namespace {
 
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
-constexpr uint32_t version = 4;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos
+constexpr uint32_t version = 5;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
+                                 // 5: mean hierarchy (k_folded)
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -138,6 +139,7 @@ void write_sampler(writer& w, const light_sampler& ls) {
     w.column(b->stats.w_cv);
     w.column(b->stats.cv);
     w.column(b->stats.p1_folded);
+    w.column(b->stats.k_folded);
     w.value(uint8_t(b->frozen));
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
@@ -161,9 +163,10 @@ void read_sampler(reader& r, light_sampler& ls) {
     }
     std::vector<pair_weight> weight = r.column<pair_weight>(pairs);
     std::vector<float> wcol = r.column<float>(pairs + 4), w_cv = r.column<float>(pairs + 4),
-                       cv = r.column<float>(pairs + 4), p1_folded = r.column<float>(pairs);
+                       cv = r.column<float>(pairs + 4), p1_folded = r.column<float>(pairs),
+                       k_folded = r.column<float>(pairs);
     auto valid = [](float x) { return std::isfinite(x) && x >= 0; };
-    for (const std::vector<float>* c : {&wcol, &w_cv, &p1_folded})
+    for (const std::vector<float>* c : {&wcol, &w_cv, &p1_folded, &k_folded})
       for (float x : *c)
         if (!valid(x)) r.fail("sampling weights");
     for (float x : cv)
@@ -179,6 +182,7 @@ void read_sampler(reader& r, light_sampler& ls) {
     b->stats.w_cv = std::move(w_cv);
     b->stats.cv = std::move(cv);
     b->stats.p1_folded = std::move(p1_folded);
+    b->stats.k_folded = std::move(k_folded);
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
     read_regions(r, d->deeper.regions);
@@ -222,7 +226,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
   h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
-  h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation);
+  h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
   const donikian_params& d = p.sampler.donikian;
   h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
   return h.h;

@@ -333,6 +333,9 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--bayes-hierarchy", o.bayes.hierarchy,
                 "Concentration of a fine region's Beta prior on p0, centred on its coarse parent's posterior (0 = off, default 1)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
+  r->add_flag_callback("--bayes-no-mean-hierarchy", [&o] { o.bayes.mean_hierarchy = false; },
+                       "Ablation: a fine region's prior mean is its own bound only, not also capped by its coarse region's "
+                       "posterior mean")->group(bg);
   r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0, default 0.3)")
       ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
 }

@@ -848,6 +848,67 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
   }
 }
 
+TEST_CASE("under the mean hierarchy a fine pair's prior mean is the lower of its bound and its parent's mean", "[bayes]") {
+  // Region prior: a fine pair's prior mean of z is min(mu0, k_parent), k_parent = (kappa0 mu0_parent + n1 zbar) /
+  // (kappa0 + n1) the parent's posterior mean under its own bound; W = sqrt(p1 Q(mean)) is evaluated there. The
+  // parent pools the fine pair's samples and (here) more of its own, far below the bound.
+  for (bool means : {true, false}) {
+    INFO("mean hierarchy " << means);
+    auto t = make_scene(3, false);
+    sampler_params sp;
+    sp.kind = sampler_kind::bayes;
+    sp.regions.shared_cut_lights = 0;
+    sp.bayes.mean_hierarchy = means;
+    REQUIRE(sp.bayes.region_prior);
+    light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+    bayes_sampler& s = std::get<bayes_sampler>(ls);
+    shade_point pt = pixel_point(*t, 4, 4);
+    auto ctx = std::make_unique<cut_context>();
+    s.prepare(*ctx, pt);
+    REQUIRE(ctx->count == 3);
+    int fine = ctx->region, coarse = s.regions.parent[size_t(fine)];
+    REQUIRE(coarse != invalid_id);
+    size_t base = size_t(s.regions.pair_offset[size_t(fine)]);
+    size_t cbase = size_t(s.regions.pair_offset[size_t(coarse)]);
+    // A parent without data leaves every child at its own bound (the parent's bound covers a larger box).
+    for (int j = 0; j < 3; j++) {
+      size_t i = base + size_t(j);
+      CHECK(s.stats.mu0[cbase + size_t(j)] >= s.stats.mu0[i]);
+      CHECK(prior_mean(s.stats, i, s.regions.pair_parent[i], s.params) == double(s.stats.mu0[i]));
+    }
+    // Cluster 0: two samples at the fine point, then 40 more reach the parent only, at a hundredth of the bound.
+    std::vector<bayes_row> rows(1);
+    double y_bound = double(s.stats.mu0[base]) * ctx->gfac[0] * pt.albedo / M_PI;  // a sample with z = mu0
+    REQUIRE(y_bound > 0);
+    for (double f : {0.02, 0.03}) {
+      light_choice c;
+      c.cluster = 0;
+      s.record(rows[0], nee_event<cut_context>{ctx.get(), c, float(f * y_bound)});
+    }
+    s.learn(rows);
+    std::vector<bayes_row> more(1);
+    double low = 0.01 * s.stats.mu0[base];
+    for (int k = 0; k < 40; k++) more[0].add(int(cbase), low * (1 + 0.01 * k));
+    merge_rows(s.stats, more, s.params, nullptr);
+    refresh_weights(s.stats, &s.regions.pair_parent, s.params);
+    const pair_moments& mp = s.stats.m[cbase];
+    REQUIRE(mp.n1 == 42);
+    double k_parent = (s.params.kappa0 * s.stats.mu0[cbase] + mp.n1 * mp.mean) / (s.params.kappa0 + mp.n1);
+    REQUIRE(k_parent < 0.1 * s.stats.mu0[base]);
+    double expect = means ? std::min(double(s.stats.mu0[base]), k_parent) : double(s.stats.mu0[base]);
+    CHECK(prior_mean(s.stats, base, int(cbase), s.params) == Approx(expect).epsilon(1e-12));
+    double w_expect = eval_weight(s.stats.weight[base], s.params, expect, 1.0);
+    double w_bound = eval_weight(s.stats.weight[base], s.params, s.stats.mu0[base], 1.0);
+    CHECK(s.stats.w[base] == Approx(w_expect).epsilon(1e-6));
+    if (means) CHECK(w_expect < 0.5 * w_bound);  // decisive: the parent's mean pulls the fine weight down
+    CHECK(std::isfinite(s.stats.w[base]));
+    CHECK(s.stats.w[base] > 0);
+    // Clusters 1 and 2 (no data anywhere) keep their bound.
+    for (int j = 1; j < 3; j++)
+      CHECK(prior_mean(s.stats, base + size_t(j), int(cbase) + j, s.params) == double(s.stats.mu0[base + size_t(j)]));
+  }
+}
+
 TEST_CASE("control variates apply at unweighted NEE to nearly always visible clusters", "[bayes]") {
   // Cluster 0 is always visible with a steady contribution, cluster 1 is visible half the time, cluster 2 has no
   // data. Where NEE is unweighted (sp.last) cluster 0 gets the control variate c = E[1 - p0] k g and the pmf the

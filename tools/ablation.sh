@@ -21,6 +21,7 @@ variants=(
   "Beta(1, 0.03) on p0 (a0 1: the last defaults)|--bayes-a0 1"
   "Beta(1, 1) on p0|--bayes-a0 1 --bayes-b0 1"
   "no hierarchy|--bayes-hierarchy 0"
+  "no mean hierarchy|--bayes-no-mean-hierarchy"
   "c 1 (prior CV 100%)|--bayes-c 1"
   "earlier defaults (a0 1, b0 1, c 1, hier. 4)|--bayes-a0 1 --bayes-b0 1 --bayes-c 1 --bayes-hierarchy 4"
   "max cut 256|--max-cut 256"
