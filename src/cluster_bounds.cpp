@@ -23,8 +23,8 @@ void eval_node_bounds(const light_tree_data& tree, const int* nodes, int count, 
   const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
   const __m128 sign_mask = _mm_castsi128_ps(_mm_set1_epi32(int(0x80000000u)));
   for (int j0 = 0; j0 < count; j0 += 4) {
-    // Four nodes as three 4x4 transposes of their packs (missing lanes repeat the last node; their results are
-    // never read): rows (cx, cy, cz, r), (ax, ay, az, cos_o), (sin_o, intensity, pad, pad).
+    // Four nodes as two 4x4 transposes of their packs (missing lanes repeat the last node; their results are
+    // never read), rows (cx, cy, cz, r) and (ax, ay, az, cos_o), and the (sin_o, intensity) pairs as two shuffles.
     const float* q[4];
     for (int k = 0; k < 4; k++) q[k] = &tree.packed[size_t(nodes[std::min(j0 + k, count - 1)])].cx;
     __m128 cx = _mm_loadu_ps(q[0]), cy = _mm_loadu_ps(q[1]), cz = _mm_loadu_ps(q[2]), r = _mm_loadu_ps(q[3]);
@@ -32,9 +32,12 @@ void eval_node_bounds(const light_tree_data& tree, const int* nodes, int count, 
     __m128 ax = _mm_loadu_ps(q[0] + 4), ay = _mm_loadu_ps(q[1] + 4), az = _mm_loadu_ps(q[2] + 4),
            co = _mm_loadu_ps(q[3] + 4);
     _MM_TRANSPOSE4_PS(ax, ay, az, co);
-    __m128 so = _mm_loadu_ps(q[0] + 8), inten = _mm_loadu_ps(q[1] + 8), p2 = _mm_loadu_ps(q[2] + 8),
-           p3 = _mm_loadu_ps(q[3] + 8);
-    _MM_TRANSPOSE4_PS(so, inten, p2, p3);
+    __m128 s01 = _mm_loadh_pi(_mm_loadl_pi(zero, reinterpret_cast<const __m64*>(q[0] + 8)),
+                              reinterpret_cast<const __m64*>(q[1] + 8));  // so0, in0, so1, in1
+    __m128 s23 = _mm_loadh_pi(_mm_loadl_pi(zero, reinterpret_cast<const __m64*>(q[2] + 8)),
+                              reinterpret_cast<const __m64*>(q[3] + 8));  // so2, in2, so3, in3
+    __m128 so = _mm_shuffle_ps(s01, s23, _MM_SHUFFLE(2, 0, 2, 0));
+    __m128 inten = _mm_shuffle_ps(s01, s23, _MM_SHUFFLE(3, 1, 3, 1));
     __m128 tx = _mm_sub_ps(_mm_set1_ps(p.x), cx);
     __m128 ty = _mm_sub_ps(_mm_set1_ps(p.y), cy);
     __m128 tz = _mm_sub_ps(_mm_set1_ps(p.z), cz);
