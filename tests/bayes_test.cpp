@@ -5,6 +5,7 @@
 // standard deviation, and the ablations (mean only, no prior, no distance regression).
 #include <catch2/catch.hpp>
 #include <memory>
+#include <optional>
 
 #include "bayes_sampler.h"
 #include "bayes_stats.h"
@@ -183,6 +184,30 @@ shade_point pixel_point(const test_scene& t, int x, int y) {
   REQUIRE(h.tri != invalid_id);
   surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, dir);
   return shade_point{sp.p, sp.ng, 0.5f, y * t.in.camera.width + x, 1};
+}
+
+// A bayes sampler over make_scene(3, false) whose cuts are the 3 lamps (3 clusters, not a shared cut of 6 leaves),
+// with bayes parameters `bp`, and a context prepared at pixel (4, 4) whose cut is those 3 clusters.
+struct three_lamps {
+  std::unique_ptr<test_scene> t;
+  std::optional<light_sampler> ls;
+  shade_point pt;
+  std::unique_ptr<cut_context> ctx;
+  bayes_sampler& sampler() { return std::get<bayes_sampler>(*ls); }
+};
+three_lamps make_three_lamps(const bayes_params& bp) {
+  three_lamps f;
+  f.t = make_scene(3, false);
+  sampler_params sp;
+  sp.kind = sampler_kind::bayes;
+  sp.regions.shared_cut_lights = 0;
+  sp.bayes = bp;
+  f.ls.emplace(make_light_sampler(sp, f.t->in, f.t->tree));
+  f.pt = pixel_point(*f.t, 4, 4);
+  f.ctx = std::make_unique<cut_context>();
+  f.sampler().prepare(*f.ctx, f.pt);
+  REQUIRE(f.ctx->count == 3);
+  return f;
 }
 
 // The prior of cluster j of a prepared context at pt in the sampler's mode, as the arguments of posterior_weight:
@@ -571,17 +596,11 @@ struct convergence_result {
 };
 
 convergence_result run_convergence(const bayes_params& params, const convergence_setup& cs, int n, uint64_t seed) {
-  auto t = make_scene(3, false);  // 3 lamps (coherent quads: 3 clusters)
-  sampler_params sp;
-  sp.kind = sampler_kind::bayes;
-  sp.regions.shared_cut_lights = 0;  // the 3 quads form 3 clusters (not a cut of 6 leaves)
-  sp.bayes = params;
-  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
-  bayes_sampler& s = std::get<bayes_sampler>(ls);
-  shade_point pt = pixel_point(*t, 4, 4);
-  auto ctx = std::make_unique<cut_context>();
-  s.prepare(*ctx, pt);
-  REQUIRE(ctx->count == 3);
+  three_lamps f = make_three_lamps(params);
+  auto& t = f.t;
+  bayes_sampler& s = f.sampler();
+  shade_point pt = f.pt;
+  auto& ctx = f.ctx;
   REQUIRE(s.regions.key[size_t(ctx->region)] == ctx->fine_key);  // the point's own fine region
   convergence_result r;
   // Region prior: the statistics hold the albedo-free z = (Y / (albedo / pi)) d^2.
@@ -717,17 +736,14 @@ TEST_CASE("the naive ablation follows plug in moments exactly", "[bayes]") {
   // weight (the bound at the point, or mu0 g with the region prior) and eps = 1e-3.
   for (bool region : {true, false}) {
     INFO("region prior " << region);
-    auto t = make_scene(3, false);
-    sampler_params sp;
-    sp.kind = sampler_kind::bayes;
-    sp.regions.shared_cut_lights = 0;  // the 3 quads form 3 clusters (not a cut of 6 leaves)
-    sp.bayes.prior = false;
-    sp.bayes.region_prior = region;
-    light_sampler ls = make_light_sampler(sp, t->in, t->tree);
-    bayes_sampler& s = std::get<bayes_sampler>(ls);
-    shade_point pt = pixel_point(*t, 4, 4);
-    auto ctx = std::make_unique<cut_context>();
-    s.prepare(*ctx, pt);
+    bayes_params bp;
+    bp.prior = false;
+    bp.region_prior = region;
+    three_lamps f = make_three_lamps(bp);
+    auto& t = f.t;
+    bayes_sampler& s = f.sampler();
+    shade_point pt = f.pt;
+    auto& ctx = f.ctx;
     REQUIRE(ctx->count == 3);
     double prior_pmf[3];
     for (int j = 0; j < 3; j++) prior_pmf[j] = cluster_pmf(*ctx, j);
@@ -773,19 +789,15 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
   for (int mode = 0; mode < 4; mode++) {
     bool second_moment = mode & 1, region = mode & 2;
     INFO("second moment " << second_moment << " region prior " << region);
-    auto t = make_scene(3, false);
-    sampler_params sp;
-    sp.kind = sampler_kind::bayes;
-    sp.regions.shared_cut_lights = 0;  // the 3 quads form 3 clusters (not a cut of 6 leaves)
-    sp.bayes.second_moment = second_moment;
-    sp.bayes.region_prior = region;
-    REQUIRE(sp.bayes.hierarchy > 0);
-    light_sampler ls = make_light_sampler(sp, t->in, t->tree);
-    bayes_sampler& s = std::get<bayes_sampler>(ls);
-    shade_point pt = pixel_point(*t, 4, 4);
-    auto ctx = std::make_unique<cut_context>();
-    s.prepare(*ctx, pt);
-    REQUIRE(ctx->count == 3);
+    bayes_params bp;
+    bp.second_moment = second_moment;
+    bp.region_prior = region;
+    REQUIRE(bp.hierarchy > 0);
+    three_lamps f = make_three_lamps(bp);
+    auto& t = f.t;
+    bayes_sampler& s = f.sampler();
+    shade_point pt = f.pt;
+    auto& ctx = f.ctx;
     int fine = ctx->region;
     REQUIRE(s.regions.key[size_t(fine)] == ctx->fine_key);
     int coarse = s.regions.parent[size_t(fine)];
@@ -854,18 +866,13 @@ TEST_CASE("under the mean hierarchy a fine pair's prior mean is the lower of its
   // parent pools the fine pair's samples and (here) more of its own, far below the bound.
   for (bool means : {true, false}) {
     INFO("mean hierarchy " << means);
-    auto t = make_scene(3, false);
-    sampler_params sp;
-    sp.kind = sampler_kind::bayes;
-    sp.regions.shared_cut_lights = 0;
-    sp.bayes.mean_hierarchy = means;
-    REQUIRE(sp.bayes.region_prior);
-    light_sampler ls = make_light_sampler(sp, t->in, t->tree);
-    bayes_sampler& s = std::get<bayes_sampler>(ls);
-    shade_point pt = pixel_point(*t, 4, 4);
-    auto ctx = std::make_unique<cut_context>();
-    s.prepare(*ctx, pt);
-    REQUIRE(ctx->count == 3);
+    bayes_params bp;
+    bp.mean_hierarchy = means;
+    REQUIRE(bp.region_prior);
+    three_lamps f = make_three_lamps(bp);
+    bayes_sampler& s = f.sampler();
+    shade_point pt = f.pt;
+    auto& ctx = f.ctx;
     int fine = ctx->region, coarse = s.regions.parent[size_t(fine)];
     REQUIRE(coarse != invalid_id);
     size_t base = size_t(s.regions.pair_offset[size_t(fine)]);
@@ -914,17 +921,12 @@ TEST_CASE("control variates apply at unweighted NEE to nearly always visible clu
   // data. Where NEE is unweighted (sp.last) cluster 0 gets the control variate c = E[1 - p0] k g and the pmf the
   // residual's weight sqrt(E[1 - p0] h + E[1 - p0] E[p0] k^2) g; clusters 1 and 2 (E[1 - p0] < cv_min_visible) keep
   // the plain weight and c = 0. Elsewhere (MIS-weighted NEE) nothing changes.
-  auto t = make_scene(3, false);
-  sampler_params sp;
-  sp.kind = sampler_kind::bayes;
-  sp.regions.shared_cut_lights = 0;
-  REQUIRE(sp.bayes.control_variate);
-  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
-  bayes_sampler& s = std::get<bayes_sampler>(ls);
-  shade_point pt = pixel_point(*t, 4, 4);
-  auto ctx = std::make_unique<cut_context>();
-  s.prepare(*ctx, pt);
-  REQUIRE(ctx->count == 3);
+  three_lamps f = make_three_lamps(bayes_params{});
+  REQUIRE(f.sampler().params.control_variate);
+  auto& t = f.t;
+  bayes_sampler& s = f.sampler();
+  shade_point pt = f.pt;
+  auto& ctx = f.ctx;
   pcg32 rng(61, 8);
   std::vector<bayes_row> rows(1);
   for (int i = 0; i < 4000; i++) {
