@@ -25,8 +25,9 @@ constexpr float orientation_floor = 1e-3f;
 }  // namespace
 
 void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
-  locate_region(ctx, regions, sp);
   ctx.cv = false;
+  if (fallback) return;  // power sampling: no region, no weights
+  locate_region(ctx, regions, sp);
   if (ctx.count == 1) {
     // One cluster: its probability is 1 whatever was learned (and nothing is recorded for it).
     ctx.cdf[0] = 0;
@@ -189,6 +190,16 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
 }
 
 void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
+  if (fallback) return;
+  if (!px_delta.empty()) {
+    // Had power sampling (probability q) chosen this event's light instead of p, the event would have added a p / q
+    // (same MIS weight): its second moment E_p[(a p / q)^2 q / p] = E_p[a^2 p / q], against the learned estimator's
+    // own added_total^2 (control variate included). The means agree, so the difference is the variance's.
+    double a = e.added, p = e.choice.prob;
+    double q = power.pmf({}, e.choice.light);
+    double with_power = a == 0 ? 0.0 : q > 0 ? a * a * p / q : HUGE_VAL;
+    px_delta[size_t(e.pixel)] += float(with_power - double(e.added_total) * e.added_total);
+  }
   const cut_context& ctx = *e.context;
   row.requests.add(ctx);
   int j = e.choice.cluster;
@@ -214,6 +225,75 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   int& slot = ctx.rec_slot[j];
   if (slot < 0) slot = row.slot_of(ctx.pair_base + j);
   row.add_at(slot, z);
+}
+
+void bayes_sampler::sample_done(row_state& row, int pixel, vec3f l) const {
+  if (px_var.empty()) return;
+  if (pixel != row.check_pixel) {
+    if (row.check_pixel >= 0) flush_check(row);
+    row.check_pixel = pixel;
+    row.check_n = row.check_mean = row.check_m2 = 0;
+  }
+  double y = luminance(l);
+  row.check_n += 1;
+  double d = y - row.check_mean;
+  row.check_mean += d / row.check_n;
+  row.check_m2 += d * (y - row.check_mean);
+}
+
+void bayes_sampler::flush_check(const row_state& row) const {
+  size_t i = size_t(row.check_pixel);
+  if (row.check_n >= 2) {
+    px_var[i] = float(row.check_m2 * row.check_n / (row.check_n - 1));  // n s^2, s^2 the unbiased sample variance
+    return;
+  }
+  // One sample in this pass: half the squared difference to the pixel's sample of the pass before (both passes of
+  // one spp) is an unbiased estimate of its variance.
+  float y = float(row.check_mean);
+  px_var[i] = std::isfinite(px_prev[i]) ? 0.5f * (y - px_prev[i]) * (y - px_prev[i]) : 0.0f;
+  px_prev[i] = y;
+}
+
+void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std::vector<double>& film, double weight,
+                                   int pass_spp, int spp) {
+  if (fallback || frozen || params.oracle_spp > 0 || !(params.fallback_ratio > 0) || !(weight > 0)) return;
+  size_t n = film.size() / 3;
+  // Checked: passes of two spp or more, and passes of one after one (see flush_check), from 4 spp on.
+  bool paired = pass_spp >= 2 || (pass_spp == 1 && px_prev.size() == n && check_pairs);
+  if (px_var.size() == n) {
+    for (const row_state& r : rows)
+      if (r.check_pixel >= 0) flush_check(r);
+    check_pairs = pass_spp == 1;  // the next pass of one spp has this pass's samples to pair with
+  }
+  if (px_var.size() == n && paired && spp >= 4) {
+    // Summed over the pass's samples with relMSE's weights 1 / (m^2 + 0.01), m the pixel's mean luminance with this
+    // pass included (a pixel whose earlier samples missed a bright edge would otherwise weigh as black): V, the
+    // learned estimator's variance, and V + D, power sampling's (D: the NEE events' second moments, see record).
+    double var = 0, delta = 0;
+    for (size_t i = 0; i < n; i++) {  // in pixel order
+      vec3f m = {float(film[3 * i] / weight), float(film[3 * i + 1] / weight), float(film[3 * i + 2] / weight)};
+      float y = luminance(m);
+      double w = 1.0 / (double(y) * y + 0.01);
+      var += w * px_var[i];
+      delta += w * px_delta[i];
+    }
+    bool valid = var > 0 && std::isfinite(var) && std::isfinite(delta);
+    check_ratio = valid ? (var + delta) / var : 0.0;
+    bool below = valid && var + delta < params.fallback_ratio * var;
+    fallback_votes = below ? fallback_votes + 1 : 0;
+    if (fallback_votes >= 2) {
+      fallback = true;
+      fallback_spp = spp;
+      px_var = {};
+      px_delta = {};
+      px_prev = {};
+      return;
+    }
+  }
+  px_var.assign(n, 0.0f);
+  px_delta.assign(n, 0.0f);
+  if (pass_spp == 1 && px_prev.size() != n) px_prev.assign(n, NAN);
+  if (pass_spp > 1) px_prev = {};
 }
 
 void bayes_sampler::begin_frame(double decay) {
@@ -280,7 +360,7 @@ void bayes_sampler::rebuild_posterior() {
 }
 
 void bayes_sampler::learn(std::vector<row_state>& rows) {
-  if (frozen) return;
+  if (frozen || fallback) return;
   const std::vector<int>* parents = params.hierarchy > 0 ? &regions.pair_parent : nullptr;
   using clock = std::chrono::steady_clock;
   auto secs = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };

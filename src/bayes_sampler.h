@@ -7,6 +7,7 @@
 
 #include "bayes_stats.h"
 #include "cut_sampling.h"
+#include "simple_samplers.h"
 
 #include <vector>
 
@@ -31,16 +32,43 @@ struct bayes_sampler {
   learn_timing timing;
   std::vector<int> first_child, next_sibling;  // per pair: the fine pairs of a coarse pair, as a linked list
 
-  void locate(context& ctx, const shade_point& sp) const { locate_region(ctx, regions, sp); }
+  // Fallback (bayes_params::fallback_ratio): once on, lights are chosen by power and nothing more is learned.
+  power_sampler power;
+  bool fallback = false;
+  int fallback_votes = 0;  // consecutive checked passes whose ratio was below the threshold
+  int fallback_spp = 0;    // spp rendered when it fell back (reports)
+  double check_ratio = 0;  // the last checked pass's estimated relMSE ratio, power over learned (0: none yet)
+  // Per pixel, for the fallback check of the current pass (empty while it does not run): the sum over its samples
+  // of their luminance's variance, and of its NEE events' second-moment change under power sampling. Each pixel is
+  // written by the one task rendering its row (no races), and summed in pixel order.
+  mutable std::vector<float> px_var, px_delta;
+  mutable std::vector<float> px_prev;  // passes of one spp: each pixel's sample luminance in the pass before (NaN: none)
+  bool check_pairs = false;            // the last pass had one spp: px_prev holds its samples
+  void flush_check(const row_state& row) const;
+
+  void locate(context& ctx, const shade_point& sp) const {
+    if (!fallback) locate_region(ctx, regions, sp);
+  }
   void prepare(context& ctx, const shade_point& sp) const;
   // Region-prior mode's weights at a point (prepare's fast path): W of each pair times 1 / d^2, zero for clusters
   // entirely behind the point's surface.
   void prepare_region_prior(context& ctx, const shade_point& sp) const;
   light_choice sample(const context& ctx, double u, double u_inner) const {
+    if (fallback) return power.sample({}, u, u_inner);
     return sample_cut(ctx, *tree, *lights, u, u_inner);
   }
-  float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
+  float pmf(const context& ctx, int light) const {
+    return fallback ? power.pmf({}, light) : cut_pmf(ctx, *tree, *lights, light);
+  }
   void record(row_state& row, const nee_event<context>& e) const;
+  void sample_done(row_state& row, int pixel, vec3f l) const;
+  // Between passes, before learn: the pass's estimated relMSE ratio of power sampling over the learned sampler
+  // (pixel weights from `film`, sum_i w_i x_i over `weight` in RGB, which includes the pass); falls back when it was
+  // below the threshold in two checked passes in a row. Checked: passes that end at 4 spp or more, of two spp or more
+  // (a pixel's variance from its own samples) or of one spp after one (from the pair). `pass_spp`: the pass's spp,
+  // `spp`: the total after it. The check's columns are sized for the film's pixels.
+  void check_fallback(const std::vector<row_state>& rows, const std::vector<double>& film, double weight,
+                      int pass_spp, int spp);
   // Control variates (prepare set ctx.cv): the emission colour of cluster j (luminance 1), the colour-weighted sum
   // of every cluster's learned mean c_j, and c_J of one cluster in colour.
   vec3f cluster_color(const context& ctx, int j) const {

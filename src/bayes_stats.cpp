@@ -105,6 +105,8 @@ void bayes_row::clear() {
   used.clear();
   acc.clear();
   generation++;
+  check_pixel = -1;
+  check_n = check_mean = check_m2 = 0;
 }
 
 int bayes_row::slot_of(int pair) {

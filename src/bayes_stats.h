@@ -45,6 +45,10 @@ struct bayes_params {
   bool mean_hierarchy = true;    // region prior with the hierarchy: a fine pair's prior mean of z is the lower of its
                                  // bound mu0 and its coarse parent's posterior mean (which pools the samples of all
                                  // its fine regions), so a new fine region starts from what its surroundings learned
+  double fallback_ratio = 1.25;  // fall back to power sampling for the rest of the render when the estimated relMSE
+                                 // per sample of power sampling is below this many times the learned one's in two
+                                 // checked passes in a row (from 4 spp on): where learning cannot pay for its own
+                                 // cost (bayes costs 1.4-2.6x power's time per sample on the data/ scenes); 0: never
   bool control_variate = true;   // region prior only: where NEE is unweighted (direct illumination, the last path
                                  // vertex), add the learned mean c_j = E[1 - p0] k_j / d^2 of every cluster and
                                  // estimate the residual (Y_J - c_J) / P_J, with P_j proportional to the root of the
@@ -182,6 +186,12 @@ struct bayes_row {
   std::vector<uint32_t> order;   // merge_rows: the row's updates (acc index * 2 + 1 for the parent's) by bucket
   std::vector<uint32_t> start;   // merge_rows: where each bucket's updates begin in `order` (buckets + 1)
   uint64_t generation = 0;      // incremented by clear(): caches of accumulator indices check it
+  // The fallback check (bayes_sampler::check_fallback): the pixel being rendered and the Welford sums of its
+  // samples' luminance in this pass (the pixel's variance goes to the sampler's column when the next one starts).
+  int check_pixel = -1;
+  double check_n = 0, check_mean = 0, check_m2 = 0;
+  // The sum over the current pixel's samples of their variance: n s^2 with s^2 the unbiased sample variance.
+  double check_pending() const { return check_n >= 2 ? check_m2 * check_n / (check_n - 1) : 0.0; }
   void clear();
   // Index in acc of pair's accumulator (created empty if absent).
   int slot_of(int pair);

@@ -28,6 +28,7 @@ struct bound_sampler {
   }
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
   void record(row_state& row, const nee_event<context>& e) const { row.add(*e.context); }
+  void sample_done(row_state&, int, vec3f) const {}
   void learn(std::vector<row_state>& rows);
   void begin_frame(double) {}  // regions and cuts do not depend on the sun's direction
 };

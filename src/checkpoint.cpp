@@ -15,8 +15,8 @@ namespace bl {
 namespace {
 
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
-constexpr uint32_t version = 5;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
-                                 // 5: mean hierarchy (k_folded)
+constexpr uint32_t version = 6;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
+                                 // 5: mean hierarchy (k_folded); 6: bayes fallback check
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -141,6 +141,15 @@ void write_sampler(writer& w, const light_sampler& ls) {
     w.column(b->stats.p1_folded);
     w.column(b->stats.k_folded);
     w.value(uint8_t(b->frozen));
+    // The fallback check: its decision and votes, and the state it carries from one pass to the next (the per-pixel
+    // sums are reset after every pass: only whether they run; the samples of a pass of one spp, to pair with).
+    w.value(uint8_t(b->fallback));
+    w.value(int32_t(b->fallback_votes));
+    w.value(int32_t(b->fallback_spp));
+    w.value(b->check_ratio);
+    w.value(uint8_t(b->check_pairs));
+    w.value(uint64_t(b->px_var.size()));
+    w.column(b->px_prev);
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
     write_regions(w, d->deeper.regions);
@@ -174,6 +183,18 @@ void read_sampler(reader& r, light_sampler& ls) {
     for (const pair_weight& x : weight)
       if (!std::isfinite(x.w2) || !std::isfinite(x.w1) || !std::isfinite(x.w0) || !std::isfinite(x.wc)) r.fail("sampling weights");
     b->frozen = r.value<uint8_t>() != 0;
+    b->fallback = r.value<uint8_t>() != 0;
+    b->fallback_votes = r.value<int32_t>();
+    b->fallback_spp = r.value<int32_t>();
+    b->check_ratio = r.value<double>();
+    b->check_pairs = r.value<uint8_t>() != 0;
+    uint64_t checked = r.value<uint64_t>();
+    b->px_prev = r.column<float>();
+    if (b->fallback_votes < 0 || b->fallback_spp < 0 || !std::isfinite(b->check_ratio) || checked > (uint64_t(1) << 40) ||
+        (!b->px_prev.empty() && b->px_prev.size() != checked))
+      r.fail("fallback check");
+    b->px_var.assign(size_t(checked), 0.0f);
+    b->px_delta.assign(size_t(checked), 0.0f);
     // Prior means and coefficients are functions of the regions and statistics: recomputed (bit for bit the same);
     // then the saved weights replace the recomputed ones.
     b->rebuild_posterior();
@@ -227,6 +248,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
   h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
   h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
+  h.value(b.fallback_ratio);
   const donikian_params& d = p.sampler.donikian;
   h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
   return h.h;
@@ -291,6 +313,8 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
   if (result.passes < 0 || result.spp < 0 || !(result.film_weight >= 0) || (result.spp > 0) != (result.film_weight > 0))
     r.fail("pass state");
   read_sampler(r, sampler);
+  if (auto* b = std::get_if<bayes_sampler>(&sampler); b && !b->px_var.empty() && b->px_var.size() != result.film.size() / 3)
+    r.fail("fallback check");  // its columns are indexed by pixel
   if (r.pos != body.size()) r.fail("trailing data");
 }
 

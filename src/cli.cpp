@@ -336,6 +336,11 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_flag_callback("--bayes-no-mean-hierarchy", [&o] { o.bayes.mean_hierarchy = false; },
                        "Ablation: a fine region's prior mean is its own bound only, not also capped by its coarse region's "
                        "posterior mean")->group(bg);
+  r->add_option("--bayes-fallback-ratio", o.bayes.fallback_ratio,
+                "Fall back to power sampling for the rest of the render when its estimated relMSE per sample is below "
+                "this many times the learned sampler's in two checked passes in a row (from 4 spp on): where learning "
+                "cannot pay for its own cost (default 1.25; 0 = never)")
+      ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0, default 0.3)")
       ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
 }

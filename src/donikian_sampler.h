@@ -58,6 +58,7 @@ struct donikian_sampler {
   }
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
   void record(row_state& row, const nee_event<context>& e) const;
+  void sample_done(row_state&, int, vec3f) const {}
   void learn(std::vector<row_state>& rows);
   // Scales the pixel and block estimates (sums and counts alike) by `decay`.
   void begin_frame(double decay);

@@ -146,7 +146,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     tm.stop(prof_select, t0);
     if (choice.light != invalid_id && choice.prob > 0) {
       st.nee_samples++;
-      float value = 0;
+      float value = 0, added = 0, added_total = 0;
       t0 = tm.start();
       light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, r.u[dim_light_u], r.u[dim_light_v]);
       vec3f fc = ls.pdf > 0 ? eval_bsdf_cos(bsdf, wo, ls.wi) : vec3f{0, 0, 0};
@@ -160,8 +160,10 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
           if (visible) {
             vec3f unweighted = fc * ls.le / ls.pdf;
             float w = last ? 1.0f : power_heuristic(choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
-            radiance += beta * unweighted * (w / choice.prob);
+            vec3f add = beta * unweighted * (w / choice.prob);
+            radiance += add;
             value = luminance(unweighted) / choice.prob_in_cluster;
+            added = added_total = luminance(add);
           }
         }
       }
@@ -171,13 +173,15 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
         if (ctx.cv) {
           double pj = cluster_pmf(ctx, choice.cluster);
           vec3f c = sampler.cv_total(ctx) - sampler.cv_cluster(ctx, choice.cluster) * float(1 / pj);
-          radiance += beta * (bsdf.kd + bsdf.ks) * inv_pi_f * c;
+          vec3f add = beta * (bsdf.kd + bsdf.ks) * inv_pi_f * c;
+          radiance += add;
+          added_total += luminance(add);
         }
       }
       st.nee_zero += value == 0;
       if constexpr (Sampler::learns) {
         t0 = tm.start();
-        sink.record(nee_event<typename Sampler::context>{&ctx, choice, value});
+        sink.record(nee_event<typename Sampler::context>{&ctx, choice, value, pixel, added, added_total});
         tm.stop(prof_record, t0);
       }
     }

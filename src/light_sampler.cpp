@@ -112,6 +112,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.sun_sin = sun_sin;
       s.sun_cos = sun_cos;
       s.params = params.bayes;
+      s.power = power_sampler{make_discrete(lights.power.data(), lights.count)};
       if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
         s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);
       s.regions = make_regions(params, in, tree);
@@ -127,7 +128,8 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
 size_t sampler_memory_bytes(const light_sampler& s) {
   if (auto* b = std::get_if<bound_sampler>(&s)) return region_memory_bytes(b->regions);
   if (auto* b = std::get_if<bayes_sampler>(&s))
-    return region_memory_bytes(b->regions) + b->stats.m.size() * (sizeof(pair_moments) + sizeof(pair_coeffs) + sizeof(pair_weight) + 5 * sizeof(float) + 2 * sizeof(int));
+    return region_memory_bytes(b->regions) + b->stats.m.size() * (sizeof(pair_moments) + sizeof(pair_coeffs) + sizeof(pair_weight) + 5 * sizeof(float) + 2 * sizeof(int)) +
+           (b->px_var.size() + b->px_delta.size() + b->px_prev.size()) * sizeof(float);
   if (auto* d = std::get_if<donikian_sampler>(&s))
     return region_memory_bytes(d->deeper.regions) +
            (d->pixel_sum.size() + d->pixel_count.size() + d->block_sum.size() + d->block_count.size()) * sizeof(float);

@@ -11,6 +11,7 @@
 //   static constexpr bool learns; learners also have S::row_state, record(row_state&, const nee_event&)
 //   and learn(std::vector<row_state>&) called between passes with the rows in image order; S::rows_per_state
 //   consecutive image rows (a band) share one row_state, filled in pixel order.
+//   Learners also have sample_done(row_state&, int pixel, vec3f radiance), called after each path sample.
 //   Learners may have `learn_timing timing` (seconds per part of learn, summed over passes) for profiles.
 // Invariant (unbiasedness): every light that can contribute at a point has pmf > 0 there.
 #pragma once
@@ -60,12 +61,16 @@ struct light_choice {
 };
 
 // One NEE event as a learning sampler sees it: its own context, the choice, and the sample's luminance
-// Y = f cos Le G V / (P(light | cluster) pdf) (zero when occluded or facing away).
+// Y = f cos Le G V / (P(light | cluster) pdf) (zero when occluded or facing away); with the pixel and the luminance
+// of what the event added to the path's radiance (path throughput and MIS weight included): `added` by the light
+// sample alone, `added_total` with the control variate's terms.
 template <class Context>
 struct nee_event {
   const Context* context;
   light_choice choice;
   float value;
+  int pixel = 0;
+  float added = 0, added_total = 0;
 };
 
 }  // namespace bl

@@ -50,6 +50,11 @@ struct row_sink {
   void record(const Event& e) {
     sampler->record(*row, e);
   }
+  void sample_done(int pixel, vec3f l) { sampler->sample_done(*row, pixel, l); }
+};
+// A sink that drops everything (samplers that do not learn).
+struct null_row_sink : null_sink {
+  void sample_done(int, vec3f) {}
 };
 
 // Image rows per work item (and per row state of a learning sampler).
@@ -87,6 +92,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
               double sum[3] = {0, 0, 0};
               for (int s = s0; s < s1; s++) {
                 vec3f l = trace_path_timed(in, sampler, x, y, uint64_t(s), st, sink, ctxs, tm);
+                sink.sample_done(y * w + x, l);
                 sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
               }
               double* out = &pass_sum[3 * (size_t(y) * w + x)];
@@ -102,7 +108,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
           row_sink<Sampler> sink{&sampler, &state};
           render_band(sink);
         } else {
-          null_sink sink;
+          null_row_sink sink;
           render_band(sink);
         }
         if (stopped) return;
@@ -132,6 +138,14 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     result.spp = result.passes = 0;
   }
   const double weighting = adapts(sampler) ? params.pass_weighting : 0.0;
+  if constexpr (std::is_same_v<Sampler, bayes_sampler>) {
+    // The fallback check starts afresh with each frame (its first pass is not checked).
+    if (result.spp == 0) {
+      sampler.px_var = sampler.px_delta = sampler.px_prev = {};
+      sampler.fallback_votes = 0;
+      sampler.check_pairs = false;
+    }
+  }
   std::vector<double> pass_sum(n, 0.0);
   using rows_type = std::conditional_t<Sampler::learns, pass_rows<Sampler>, pass_rows_none>;
   rows_type rows;
@@ -175,6 +189,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     for (const cycle_timers& t : rows.timers)
       for (int c = 0; c < prof_count; c++) result.profile_cycles[c] += t.cycles[c];
     auto tl = clock_type::now();
+    if constexpr (std::is_same_v<Sampler, bayes_sampler>)
+      sampler.check_fallback(rows.records, result.film, result.film_weight, count, done + count);
     if constexpr (Sampler::learns) sampler.learn(rows.records);
     else sampler.end_pass();
     result.learn_seconds += seconds_since(tl);
@@ -283,7 +299,12 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     if (params.on_pass) params.on_pass(result, sampler, true);
     result.sampler_bytes = sampler_memory_bytes(sampler);
     if (auto* b = std::get_if<bound_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
-    if (auto* b = std::get_if<bayes_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;
+    if (auto* b = std::get_if<bayes_sampler>(&sampler)) {
+      result.regions = int(b->regions.key.size());
+      result.pairs = b->regions.pairs;
+      result.fallback_spp = b->fallback_spp;
+      result.fallback_ratio = b->check_ratio;
+    }
     on_frame(frame, result);
     if (result.interrupted) return;
   }

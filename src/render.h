@@ -71,6 +71,8 @@ struct render_result {
   uint64_t profile_cycles[prof_count] = {};  // time-stamp counter cycles per stage (profile renders only)
   int regions = 0;            // regions of a region-based sampler
   int64_t pairs = 0;          // (region, cluster) pairs
+  int fallback_spp = 0;       // bayes: spp after which it fell back to power sampling (0: it did not)
+  double fallback_ratio = 0;  // bayes: the last checked estimate of power's relMSE over the learned sampler's (0: none)
   path_stats stats;
   std::vector<pass_record> log;
 };

@@ -45,6 +45,14 @@ std::string render_summary(const render_result& r, const std::vector<std::string
                   double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));
     s += buf;
   }
+  if (r.fallback_spp > 0) {
+    std::snprintf(buf, sizeof buf, "; power sampling after %d spp (learning was estimated to cut relMSE per sample only %.2fx)",
+                  r.fallback_spp, r.fallback_ratio);
+    s += buf;
+  } else if (r.fallback_ratio > 0) {
+    std::snprintf(buf, sizeof buf, "; learning estimated to cut relMSE per sample %.3gx against power sampling", r.fallback_ratio);
+    s += buf;
+  }
   if (r.setup_seconds >= 0.01) {
     std::snprintf(buf, sizeof buf, "; set-up %.2f s (light tree, regions)", r.setup_seconds);
     s += buf;

@@ -141,11 +141,22 @@ void check_scene(const built_scene& b, int depth, int spp) {
   p.threads = 2;
   std::vector<double> reference;
   double ref_mean = 0;
-  for (sampler_kind kind : all_kinds) {
+  // Every sampler, then bayes again without its fallback to power sampling and with it forced (at 5 spp).
+  std::vector<std::pair<sampler_kind, double>> runs;
+  for (sampler_kind kind : all_kinds) runs.push_back({kind, bayes_params{}.fallback_ratio});
+  runs.push_back({sampler_kind::bayes, 0.0});
+  runs.push_back({sampler_kind::bayes, 1e9});
+  for (auto [kind, fallback_ratio] : runs) {
     if (!sampler_available(kind)) continue;
-    INFO("sampler " << sampler_name(kind) << " depth " << depth << " spp " << spp);
+    INFO("sampler " << sampler_name(kind) << " depth " << depth << " spp " << spp << " fallback ratio " << fallback_ratio);
     p.sampler.kind = kind;
+    p.sampler.bayes.fallback_ratio = fallback_ratio;
     render_result r = render(b.scene, b.bvh, b.lights, p);
+    if (kind == sampler_kind::bayes) {
+      INFO("fell back after " << r.fallback_spp << " spp");
+      if (fallback_ratio == 0) CHECK(r.fallback_spp == 0);
+      if (fallback_ratio > 1e6) CHECK(r.fallback_spp == 5);
+    }
     CHECK(r.stats.bad_samples == 0);
     CHECK(r.spp == spp);
     bool finite = true;

@@ -1,0 +1,214 @@
+// The bayes sampler's fallback to power sampling (bayes_params::fallback_ratio): the check's sums against values
+// worked out by hand (the per-pixel variance of a pass's samples, pairs of one-spp passes, the NEE events' change
+// of second moment under power sampling), its decision rule (two checked passes in a row below the threshold, from
+// 4 spp on), and through the binary: it falls back where learning cannot pay (the Cornell box, path traced) and not
+// where it does (the plant room), the image stays unbiased and deterministic, and a resumed render is identical.
+#include "bayes_sampler.h"
+#include "file_io.h"
+#include "test_util.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace bl;
+using namespace bl::test;
+
+namespace {
+
+// A sampler with only what the check reads: power sampling over two lights of power 1 and 3.
+bayes_sampler two_light_sampler(double ratio) {
+  bayes_sampler s;
+  s.params.fallback_ratio = ratio;
+  s.power = power_sampler{make_discrete(std::vector<float>{1, 3}.data(), 2)};
+  return s;
+}
+
+// A film of `pixels` grey pixels of value v (weight 1).
+std::vector<double> grey_film(size_t pixels, double v) { return std::vector<double>(3 * pixels, v); }
+
+// Ends a pass whose pixels had the given variance and delta sums (the check's columns, written directly).
+void end_pass(bayes_sampler& s, const std::vector<float>& var, const std::vector<float>& delta,
+              const std::vector<double>& film, int pass_spp, int spp) {
+  std::vector<bayes_row> rows(1);
+  s.px_var = var;
+  s.px_delta = delta;
+  s.check_fallback(rows, film, 1.0, pass_spp, spp);
+}
+
+}  // namespace
+
+TEST_CASE("the fallback check sums what its definitions say", "[fallback]") {
+  bayes_sampler s = two_light_sampler(1.25);
+  std::vector<double> film = grey_film(2, 0.0);
+  std::vector<bayes_row> rows(1);
+  s.check_fallback(rows, film, 1.0, 1, 1);  // the first pass: nothing to check yet, the columns are set up
+  REQUIRE(s.px_var.size() == 2);
+  REQUIRE(s.px_delta.size() == 2);
+  REQUIRE(s.px_prev.size() == 2);  // a pass of one spp: its samples are kept for pairing
+  CHECK(s.check_ratio == 0);
+
+  // Variance: pixel 0 gets samples of luminance 1 and 3 (mean 2, unbiased variance 2, times 2 samples = 4).
+  bayes_row& row = rows[0];
+  row.clear();
+  s.sample_done(row, 0, {1, 1, 1});
+  s.sample_done(row, 0, {3, 3, 3});
+  s.sample_done(row, 1, {5, 5, 5});  // pixel 0 is written when pixel 1 starts
+  CHECK(s.px_var[0] == Approx(4.0f));
+  CHECK(row.check_pending() == 0);  // one sample: no variance of its own yet
+
+  // Second moment change: an event that added a = 2 (2.5 with its control variate) with p = 0.5 for light 0, which
+  // power sampling picks with q = 1/4: a^2 p / q - 2.5^2 = 8 - 6.25.
+  cut_context ctx;
+  nee_event<cut_context> e{&ctx, light_choice{0, 0.5f, invalid_id, 1.0f}, 1.0f, 1, 2.0f, 2.5f};
+  s.record(row, e);
+  CHECK(s.px_delta[1] == Approx(1.75f));
+  // An occluded sample (nothing added by the light) with a control variate: power would add 0.
+  nee_event<cut_context> zero{&ctx, light_choice{1, 0.25f, invalid_id, 1.0f}, 0.0f, 1, 0.0f, -0.5f};
+  s.record(row, zero);
+  CHECK(s.px_delta[1] == Approx(1.75f - 0.25f));
+
+  // Pairs of one-spp passes: half the squared difference of a pixel's samples in two consecutive passes.
+  bayes_sampler t = two_light_sampler(1.25);
+  t.check_fallback(rows, film, 1.0, 1, 1);
+  row.clear();
+  t.sample_done(row, 0, {2, 2, 2});
+  t.sample_done(row, 1, {1, 1, 1});
+  t.check_fallback(rows, film, 1.0, 1, 2);  // flushes pixel 1; the pass before had no samples kept: not checked
+  CHECK(t.check_ratio == 0);
+  REQUIRE(t.px_prev.size() == 2);
+  CHECK(t.px_prev[0] == 2.0f);
+  CHECK(t.px_prev[1] == 1.0f);
+  row.clear();
+  t.sample_done(row, 0, {4, 4, 4});
+  t.sample_done(row, 1, {1, 1, 1});
+  t.flush_check(row);  // what check_fallback does for the row's last pixel
+  CHECK(t.px_var[0] == Approx(0.5f * 4.0f));
+  CHECK(t.px_var[1] == 0.0f);
+}
+
+TEST_CASE("the fallback decision needs two checked passes in a row below the threshold", "[fallback]") {
+  // Pixel 0 black (relMSE weight 100), pixel 1 of luminance 1 (weight 1 / 1.01).
+  std::vector<double> film = {0, 0, 0, 1, 1, 1};
+  const double w0 = 100, w1 = 1 / 1.01;
+  auto ratio = [&](double v0, double v1, double d0, double d1) {
+    double var = w0 * double(float(v0)) + w1 * double(float(v1));
+    return (var + w0 * double(float(d0)) + w1 * double(float(d1))) / var;
+  };
+  std::vector<bayes_row> rows(1);
+
+  bayes_sampler s = two_light_sampler(1.25);
+  s.check_fallback(rows, film, 1.0, 1, 1);
+  // Below the threshold (1.1), but before 4 spp: not counted.
+  end_pass(s, {1, 3}, {0.1f, 0.2f}, film, 2, 3);
+  CHECK(s.fallback_votes == 0);
+  CHECK_FALSE(s.fallback);
+  end_pass(s, {1, 3}, {0.1f, 0.2f}, film, 2, 5);
+  CHECK(s.check_ratio == Approx(ratio(1, 3, 0.1, 0.2)).epsilon(1e-6));
+  CHECK(s.fallback_votes == 1);
+  CHECK_FALSE(s.fallback);
+  // Above it (2.0): the count starts again.
+  end_pass(s, {1, 3}, {1.0f, 3.0f}, film, 2, 7);
+  CHECK(s.check_ratio == Approx(2.0).epsilon(1e-6));
+  CHECK(s.fallback_votes == 0);
+  end_pass(s, {1, 3}, {0.1f, 0.2f}, film, 2, 9);
+  CHECK_FALSE(s.fallback);
+  end_pass(s, {1, 3}, {0.1f, 0.2f}, film, 3, 12);
+  CHECK(s.fallback);
+  CHECK(s.fallback_spp == 12);
+  CHECK(s.px_var.empty());  // nothing more is checked or recorded
+  CHECK(s.px_delta.empty());
+
+  // A pass whose variance is zero or whose sums are not finite decides nothing; a pass of one spp without the pass
+  // before it kept is not checked.
+  bayes_sampler t = two_light_sampler(1.25);
+  t.check_fallback(rows, film, 1.0, 3, 3);
+  end_pass(t, {0, 0}, {0.1f, 0.2f}, film, 2, 5);
+  CHECK(t.check_ratio == 0);
+  CHECK(t.fallback_votes == 0);
+  end_pass(t, {1, 3}, {INFINITY, 0}, film, 2, 7);
+  CHECK(t.fallback_votes == 0);
+  end_pass(t, {1, 3}, {0.1f, 0.2f}, film, 2, 9);
+  CHECK(t.fallback_votes == 1);
+  end_pass(t, {1, 3}, {0.1f, 0.2f}, film, 1, 10);  // neither counts nor resets
+  CHECK(t.fallback_votes == 1);
+  CHECK_FALSE(t.fallback);
+  end_pass(t, {1, 3}, {0.1f, 0.2f}, film, 2, 12);
+  CHECK(t.fallback);
+
+  // Ratio 0 never falls back; nor does a frozen (oracle) sampler.
+  for (int mode = 0; mode < 2; mode++) {
+    bayes_sampler u = two_light_sampler(mode == 0 ? 0.0 : 1.25);
+    u.frozen = mode == 1;
+    u.check_fallback(rows, film, 1.0, 2, 2);
+    for (int spp = 4; spp < 12; spp += 2) end_pass(u, {1, 3}, {0.0f, 0.0f}, film, 2, spp);
+    CHECK_FALSE(u.fallback);
+  }
+}
+
+TEST_CASE("in fallback the bayes sampler is the power sampler and learns nothing", "[fallback]") {
+  bayes_sampler s = two_light_sampler(1.25);
+  s.fallback = true;
+  cut_context ctx;
+  s.prepare(ctx, shade_point{{0, 0, 0}, {0, 1, 0}, 0.5f, 0, 1, true});
+  CHECK_FALSE(ctx.cv);
+  for (double u : {0.1, 0.3, 0.9}) {
+    light_choice c = s.sample(ctx, u, 0.5);
+    light_choice p = s.power.sample({}, u, 0.5);
+    CHECK(c.light == p.light);
+    CHECK(c.prob == p.prob);
+  }
+  CHECK(s.pmf(ctx, 0) == Approx(0.25f));
+  CHECK(s.pmf(ctx, 1) == Approx(0.75f));
+  bayes_row row;
+  nee_event<cut_context> e{&ctx, light_choice{0, 0.25f, 0, 1.0f}, 1.0f, 0, 1.0f, 1.0f};
+  s.record(row, e);
+  CHECK(row.acc.empty());
+  CHECK(row.requests.keys.empty());
+}
+
+TEST_CASE("bayes falls back where learning cannot pay and not where it does", "[fallback]") {
+  temp_dir d;
+  auto run = [&](const std::string& scene, const std::string& extra) {
+    return run_bayeslight("render " + source_path("data/" + scene + ".json") + " --width 40 --height 30 --spp 12 -o " +
+                          (d / "out.pfm") + " " + extra);
+  };
+  // The Cornell box, path traced: the NEE part of a pixel's variance is small (estimated ratio ~1.07).
+  auto cornell = run("cornell/path", "");
+  INFO(cornell.output);
+  REQUIRE(cornell.status == 0);
+  CHECK(cornell.output.find("power sampling after 5 spp") != std::string::npos);
+  // The plant room: learning cuts the error per sample ~40x (direct) and ~16x (path traced).
+  for (const char* scene : {"plant_room/direct", "plant_room/path"}) {
+    auto r = run(scene, "");
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    CHECK(r.output.find("power sampling after") == std::string::npos);
+    CHECK(r.output.find("learning estimated to cut relMSE per sample") != std::string::npos);
+  }
+  // The ablation switch.
+  auto off = run("cornell/path", "--bayes-fallback-ratio 0");
+  REQUIRE(off.status == 0);
+  CHECK(off.output.find("power sampling after") == std::string::npos);
+}
+
+TEST_CASE("a render that falls back is deterministic and resumes to the same bytes", "[fallback]") {
+  temp_dir d;
+  std::string base = "render " + source_path("data/cornell/path.json") + " --width 40 --height 30 --spp 15 --quiet";
+  std::string one = d / "one.pfm", two = d / "two.pfm";
+  REQUIRE(run_bayeslight(base + " --threads 1 -o " + one).status == 0);
+  REQUIRE(run_bayeslight(base + " --threads 2 -o " + two).status == 0);
+  CHECK(read_file(one) == read_file(two));
+  // Interrupted after 4 passes (one vote, the samples of a one-spp pass kept for pairing) and after 7 (fallen back).
+  for (int passes : {4, 7}) {
+    INFO("interrupted after " << passes << " passes");
+    std::string ck = d / ("ck" + std::to_string(passes)), part = d / "part.pfm", out = d / "resumed.pfm";
+    auto r1 = run_bayeslight(base + " -o " + part + " --checkpoint " + ck + " --stop-after-passes " +
+                             std::to_string(passes));
+    CHECK(r1.status == 130);
+    auto r2 = run_bayeslight(base + " -o " + out + " --resume " + ck);
+    INFO(r2.output);
+    REQUIRE(r2.status == 0);
+    CHECK(read_file(out) == read_file(one));
+  }
+}
