@@ -175,8 +175,14 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     progress.pass_spp = count;
     progress.rows_done = 0;
     auto t0 = clock_type::now();
-    bool complete = params.profile ? run_pass<true>(in, sampler, done, done + count, pass_sum, rows, arena, progress)
-                                   : run_pass<false>(in, sampler, done, done + count, pass_sum, rows, arena, progress);
+    auto run = [&](const auto& s) {
+      return params.profile ? run_pass<true>(in, s, done, done + count, pass_sum, rows, arena, progress)
+                            : run_pass<false>(in, s, done, done + count, pass_sum, rows, arena, progress);
+    };
+    bool complete;
+    // A bayes sampler that fell back runs its passes as the power sampler itself: the hot path has none of its code.
+    if constexpr (std::is_same_v<Sampler, bayes_sampler>) complete = sampler.fallback ? run(sampler.power) : run(sampler);
+    else complete = run(sampler);
     if (!complete) {
       result.interrupted = true;
       break;
