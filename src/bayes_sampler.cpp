@@ -277,10 +277,17 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
       var += w * px_var[i];
       delta += w * px_delta[i];
     }
-    bool valid = var > 0 && std::isfinite(var) && std::isfinite(delta);
-    check_ratio = valid ? (var + delta) / var : 0.0;
-    bool below = valid && var + delta < params.fallback_ratio * var;
+    window_var += var;
+    window_delta += delta;
+    window_samples += double(n) * pass_spp;
+  }
+  if (window_samples >= params.fallback_window) {
+    // A window is complete: its ratio votes.
+    bool valid = window_var > 0 && std::isfinite(window_var) && std::isfinite(window_delta);
+    check_ratio = valid ? (window_var + window_delta) / window_var : 0.0;
+    bool below = valid && window_var + window_delta < params.fallback_ratio * window_var;
     fallback_votes = below ? fallback_votes + 1 : 0;
+    window_var = window_delta = window_samples = 0;
     if (fallback_votes >= 2) {
       fallback = true;
       fallback_spp = spp;

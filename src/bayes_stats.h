@@ -49,6 +49,8 @@ struct bayes_params {
                                  // per sample of power sampling is below this many times the learned one's in two
                                  // checked passes in a row (from 4 spp on): where learning cannot pay for its own
                                  // cost (bayes costs 1.4-2.6x power's time per sample on the data/ scenes); 0: never
+  double fallback_window = 262144;  // samples (pixels x spp) a fallback check sums before it votes: the events that
+                                    // make power sampling bad can be rare (points by a lamp's rim)
   bool control_variate = true;   // region prior only: where NEE is unweighted (direct illumination, the last path
                                  // vertex), add the learned mean c_j = E[1 - p0] k_j / d^2 of every cluster and
                                  // estimate the residual (Y_J - c_J) / P_J, with P_j proportional to the root of the

@@ -147,6 +147,7 @@ void write_sampler(writer& w, const light_sampler& ls) {
     w.value(int32_t(b->fallback_votes));
     w.value(int32_t(b->fallback_spp));
     w.value(b->check_ratio);
+    w.value(b->window_var), w.value(b->window_delta), w.value(b->window_samples);
     w.value(uint8_t(b->check_pairs));
     w.value(uint64_t(b->px_var.size()));
     w.column(b->px_prev);
@@ -187,10 +188,12 @@ void read_sampler(reader& r, light_sampler& ls) {
     b->fallback_votes = r.value<int32_t>();
     b->fallback_spp = r.value<int32_t>();
     b->check_ratio = r.value<double>();
+    b->window_var = r.value<double>(), b->window_delta = r.value<double>(), b->window_samples = r.value<double>();
     b->check_pairs = r.value<uint8_t>() != 0;
     uint64_t checked = r.value<uint64_t>();
     b->px_prev = r.column<float>();
     if (b->fallback_votes < 0 || b->fallback_spp < 0 || !std::isfinite(b->check_ratio) || checked > (uint64_t(1) << 40) ||
+        !(b->window_samples >= 0) || std::isnan(b->window_var) || std::isnan(b->window_delta) ||
         (!b->px_prev.empty() && b->px_prev.size() != checked))
       r.fail("fallback check");
     b->px_var.assign(size_t(checked), 0.0f);
@@ -248,7 +251,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
   h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
   h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
-  h.value(b.fallback_ratio);
+  h.value(b.fallback_ratio), h.value(b.fallback_window);
   const donikian_params& d = p.sampler.donikian;
   h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
   return h.h;

@@ -80,9 +80,10 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
   int pixel = y * in.camera.width + x;
   uint64_t key = sample_key(in.seed, uint64_t(pixel), sample);
   uint64_t t0 = tm.start();
-  vertex_randoms cam = draw_vertex(key, 0, camera_dims);
+  float jx, jy;
+  pixel_jitter(in.seed, uint64_t(pixel), sample, jx, jy);
   vec3f org = in.camera.eye;
-  vec3f dir = camera_ray_dir(in.camera, float(x) + cam.u[dim_pixel_x], float(y) + cam.u[dim_pixel_y]);
+  vec3f dir = camera_ray_dir(in.camera, float(x) + jx, float(y) + jy);
   st.camera_rays++;
 
   vec3f radiance = {0, 0, 0}, beta = {1, 1, 1};

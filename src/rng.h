@@ -11,10 +11,9 @@
 
 namespace bl {
 
-// The dimension table: slots of one vertex's random block. Vertex 0 is the camera (pixel jitter).
+// The dimension table: slots of one vertex's random block (path vertices 1, 2, ...; the camera's pixel jitter is
+// pixel_jitter's, below).
 enum rng_dim : int {
-  dim_pixel_x = 0,       // camera vertex: jitter inside the pixel
-  dim_pixel_y = 1,       //
   dim_light_select = 0,  // path vertices: which light / cluster
   dim_light_inner = 1,   // second-level choice inside a cluster (tree descent)
   dim_light_u = 2,       // point on the chosen light
@@ -25,8 +24,7 @@ enum rng_dim : int {
   dim_roulette = 7,      // Russian roulette
   dim_light_select_lo = 8,  // low bits of the two light choices (they use 53-bit uniforms, see u53)
   dim_light_inner_lo = 9,
-  dims_per_vertex = 10,
-  camera_dims = 2           // the camera vertex uses only the pixel jitter
+  dims_per_vertex = 10
 };
 
 // One vertex's uniforms in [0, 1) (24-bit floats) and the raw draws behind them.
@@ -67,6 +65,35 @@ inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex, int count = dim
     r.u[i] = uint_to_unit(r.raw[i]);
   }
   return r;
+}
+
+// Bits of i in reverse order: the base-2 radical inverse of i (van der Corput) in 0.32 fixed point.
+inline uint32_t reverse_bits(uint32_t i) {
+  i = (i << 16) | (i >> 16);
+  i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+  i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+  i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+  return ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+}
+// The second dimension of the Sobol' sequence at index i in 0.32 fixed point (direction numbers of x + 1).
+inline uint32_t sobol_second(uint32_t i) {
+  uint32_t r = 0;
+  for (uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
+    if (i & 1) r ^= v;
+  return r;
+}
+
+// Jitter inside pixel `pixel` of its sample `sample`: point `sample` of the two-dimensional Sobol' sequence (van der
+// Corput and Sobol's second dimension), digitally shifted (XOR) by a random pair drawn from the PCG32 stream of the
+// pixel's key. Each sample is uniform over the pixel (unbiased), the shift is independent between pixels, and any
+// 2^k consecutive samples from a multiple of 2^k are stratified (one per cell of every 2^a x 2^b grid with a + b = k),
+// which takes most of the variance off pixels that straddle an edge (a lamp's rim against a dark ceiling).
+inline void pixel_jitter(uint64_t seed, uint64_t pixel, uint64_t sample, float& u, float& v) {
+  pcg32 rng(mix64(mix64(seed ^ 0x6a09e667f3bcc909ull) ^ pixel), 0);
+  uint32_t sx = rng(), sy = rng();
+  uint32_t i = uint32_t(sample);
+  u = uint_to_unit(reverse_bits(i) ^ sx);
+  v = uint_to_unit(sobol_second(i) ^ sy);
 }
 
 }  // namespace bl

@@ -99,7 +99,7 @@ TEST_CASE("a furnace box of emitting grey walls sums its bounces", "[analytic]")
       double exact = 0;
       for (int k = 0; k <= depth; k++) exact += le * std::pow(rho, k);
       INFO("sampler " << sampler_name(kind) << " depth " << depth);
-      check_estimate(render_pixels(b.mesh, cam, {}, true, kind, depth, 256), exact);
+      check_estimate(render_pixels(b.mesh, cam, {}, true, kind, depth, 512), exact);
     }
 }
 

@@ -1,7 +1,7 @@
 // The bayes sampler's fallback to power sampling (bayes_params::fallback_ratio): the check's sums against values
 // worked out by hand (the per-pixel variance of a pass's samples, pairs of one-spp passes, the NEE events' change
 // of second moment under power sampling), its decision rule (two checked passes in a row below the threshold, from
-// 4 spp on), and through the binary: it falls back where learning cannot pay (the Cornell box, path traced) and not
+// 4 spp on, windows of enough samples), and through the binary: it falls back where learning cannot pay (the Cornell box, path traced) and not
 // where it does (the plant room), the image stays unbiased and deterministic, and a resumed render is identical.
 #include "bayes_sampler.h"
 #include "file_io.h"
@@ -17,9 +17,10 @@ using namespace bl::test;
 namespace {
 
 // A sampler with only what the check reads: power sampling over two lights of power 1 and 3.
-bayes_sampler two_light_sampler(double ratio) {
+bayes_sampler two_light_sampler(double ratio, double window = 1) {
   bayes_sampler s;
   s.params.fallback_ratio = ratio;
+  s.params.fallback_window = window;  // 1: every checked pass is a window of its own
   s.power = power_sampler{make_discrete(std::vector<float>{1, 3}.data(), 2)};
   return s;
 }
@@ -136,6 +137,25 @@ TEST_CASE("the fallback decision needs two checked passes in a row below the thr
   end_pass(t, {1, 3}, {0.1f, 0.2f}, film, 2, 12);
   CHECK(t.fallback);
 
+  // Windows: with 2 pixels and a window of 8 samples, passes of 2 spp vote every second pass, on their summed ratio.
+  bayes_sampler w = two_light_sampler(1.25, 8);
+  w.check_fallback(rows, film, 1.0, 2, 2);
+  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 4);
+  CHECK(w.check_ratio == 0);  // half a window: no vote yet
+  CHECK(w.window_samples == 4);
+  end_pass(w, {1, 3}, {1.0f, 3.0f}, film, 2, 6);
+  CHECK(w.window_samples == 0);
+  CHECK(w.check_ratio == Approx(ratio(2, 6, 1.1, 3.2)).epsilon(1e-6));  // (1.099 + 2) / 2: above the threshold
+  CHECK(w.fallback_votes == 0);
+  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 8);
+  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 10);
+  CHECK(w.fallback_votes == 1);
+  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 12);
+  CHECK_FALSE(w.fallback);
+  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 14);
+  CHECK(w.fallback);
+  CHECK(w.fallback_spp == 14);
+
   // Ratio 0 never falls back; nor does a frozen (oracle) sampler.
   for (int mode = 0; mode < 2; mode++) {
     bayes_sampler u = two_light_sampler(mode == 0 ? 0.0 : 1.25);
@@ -170,14 +190,15 @@ TEST_CASE("in fallback the bayes sampler is the power sampler and learns nothing
 TEST_CASE("bayes falls back where learning cannot pay and not where it does", "[fallback]") {
   temp_dir d;
   auto run = [&](const std::string& scene, const std::string& extra) {
-    return run_bayeslight("render " + source_path("data/" + scene + ".json") + " --width 40 --height 30 --spp 12 -o " +
+    return run_bayeslight("render " + source_path("data/" + scene + ".json") + " --width 320 --height 240 --spp 15 -o " +
                           (d / "out.pfm") + " " + extra);
   };
-  // The Cornell box, path traced: the NEE part of a pixel's variance is small (estimated ratio ~1.07).
+  // The Cornell box, path traced: the NEE part of a pixel's variance is small (estimated ratio ~1.07). Windows of
+  // 262144 samples at 320 x 240: spp 4-7 and 8-12 (passes of 1, 1, 2, 2 spp).
   auto cornell = run("cornell/path", "");
   INFO(cornell.output);
   REQUIRE(cornell.status == 0);
-  CHECK(cornell.output.find("power sampling after 5 spp") != std::string::npos);
+  CHECK(cornell.output.find("power sampling after 12 spp") != std::string::npos);
   // The plant room: learning cuts the error per sample ~40x (direct) and ~16x (path traced).
   for (const char* scene : {"plant_room/direct", "plant_room/path"}) {
     auto r = run(scene, "");
@@ -194,13 +215,14 @@ TEST_CASE("bayes falls back where learning cannot pay and not where it does", "[
 
 TEST_CASE("a render that falls back is deterministic and resumes to the same bytes", "[fallback]") {
   temp_dir d;
-  std::string base = "render " + source_path("data/cornell/path.json") + " --width 40 --height 30 --spp 15 --quiet";
+  std::string base = "render " + source_path("data/cornell/path.json") + " --width 320 --height 240 --spp 18 --quiet";
   std::string one = d / "one.pfm", two = d / "two.pfm";
   REQUIRE(run_bayeslight(base + " --threads 1 -o " + one).status == 0);
   REQUIRE(run_bayeslight(base + " --threads 2 -o " + two).status == 0);
   CHECK(read_file(one) == read_file(two));
-  // Interrupted after 4 passes (one vote, the samples of a one-spp pass kept for pairing) and after 7 (fallen back).
-  for (int passes : {4, 7}) {
+  // Interrupted after 6 passes (a window begun, the samples of a one-spp pass kept for pairing), 8 (one vote) and
+  // 11 (fallen back at 12 spp, the end of pass 10).
+  for (int passes : {6, 8, 11}) {
     INFO("interrupted after " << passes << " passes");
     std::string ck = d / ("ck" + std::to_string(passes)), part = d / "part.pfm", out = d / "resumed.pfm";
     auto r1 = run_bayeslight(base + " -o " + part + " --checkpoint " + ck + " --stop-after-passes " +

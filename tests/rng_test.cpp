@@ -1,6 +1,7 @@
-// Tests of the random streams: pcg-cpp reference values, key separation, fixed dimension table.
+// Tests of the random streams: pcg-cpp reference values, key separation, fixed dimension table, the pixel jitter.
 #include "math.h"
 #include "rng.h"
+#include "test_util.h"
 
 #include <catch2/catch.hpp>
 
@@ -55,6 +56,59 @@ TEST_CASE("uniforms lie in the unit interval with mean one half", "[rng]") {
     }
   }
   CHECK(std::abs(sum / n - 0.5) < 5 * 0.2887 / std::sqrt(double(n)));
+}
+
+TEST_CASE("the Sobol' points behind the pixel jitter have their textbook values", "[rng]") {
+  // Van der Corput: 0, 1/2, 1/4, 3/4, 1/8, ...; Sobol's second dimension in natural order: 0, 1/2, 3/4, 1/4, 5/8, 1/8,
+  // 3/8, 7/8 (direction numbers 1/2, 3/4, 5/8, 15/16, ...).
+  const double vdc[] = {0, 0.5, 0.25, 0.75, 0.125, 0.625, 0.375, 0.875};
+  const double sob[] = {0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875};
+  for (uint32_t i = 0; i < 8; i++) {
+    CHECK(reverse_bits(i) * 0x1p-32 == vdc[i]);
+    CHECK(sobol_second(i) * 0x1p-32 == sob[i]);
+  }
+  CHECK(sobol_second(8) * 0x1p-32 == 15.0 / 16);
+  CHECK(reverse_bits(0x80000000u) == 1u);
+}
+
+TEST_CASE("pixel jitter is uniform per sample and stratified over a pixel's samples", "[rng]") {
+  // Stratified: samples [16 k, 16 k + 16) of a pixel fall one per cell of every 2^a x 2^b grid with a + b = 4.
+  for (uint64_t px : {0u, 7u, 12345u})
+    for (uint64_t k : {0u, 1u, 5u})
+      for (int a = 0; a <= 4; a++) {
+        std::set<int> cells;
+        for (uint64_t s = 16 * k; s < 16 * k + 16; s++) {
+          float u, v;
+          pixel_jitter(3, px, s, u, v);
+          REQUIRE(u >= 0.0f);
+          REQUIRE(u < 1.0f);
+          REQUIRE(v >= 0.0f);
+          REQUIRE(v < 1.0f);
+          cells.insert(int(u * float(1 << a)) * 16 + int(v * float(1 << (4 - a))));
+        }
+        CHECK(cells.size() == 16);
+      }
+  // Uniform: one sample of each of 40000 pixels (their shifts are independent), chi-square over a 10 x 10 grid
+  // (99 degrees of freedom; p > 1e-4 fails one run in 10^4), for a first and a later sample index.
+  for (uint64_t s : {0u, 37u}) {
+    std::vector<double> observed(100, 0.0), expected(100, 400.0);
+    for (uint64_t px = 0; px < 40000; px++) {
+      float u, v;
+      pixel_jitter(11, px, s, u, v);
+      observed[size_t(int(u * 10) * 10 + int(v * 10))] += 1;
+    }
+    CHECK(bl::test::chi2_pvalue(observed, expected) > 1e-4);
+  }
+  // Determinism and separation: the same (seed, pixel, sample) repeats, another seed or pixel moves the point.
+  float u0, v0, u1, v1, u2, v2, u3, v3;
+  pixel_jitter(1, 2, 3, u0, v0);
+  pixel_jitter(1, 2, 3, u1, v1);
+  pixel_jitter(2, 2, 3, u2, v2);
+  pixel_jitter(1, 3, 3, u3, v3);
+  CHECK(u0 == u1);
+  CHECK(v0 == v1);
+  CHECK((u0 != u2 || v0 != v2));
+  CHECK((u0 != u3 || v0 != v3));
 }
 
 TEST_CASE("make_frame is orthonormal for any unit normal", "[math]") {
