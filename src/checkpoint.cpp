@@ -53,7 +53,7 @@ struct writer {
   template <class T>
   void column(const std::vector<T>& v) {
     value(uint64_t(v.size()));
-    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+    if (!v.empty()) out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
   }
 };
 
@@ -77,7 +77,7 @@ struct reader {
     if (n > (in.size() - pos) / sizeof(T)) fail("truncated column");
     if (expected != size_t(-1) && n != expected) fail("column of unexpected size");
     std::vector<T> v(n);
-    std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
+    if (n > 0) std::memcpy(v.data(), in.data() + pos, n * sizeof(T));  // an empty vector's data() may be null
     pos += n * sizeof(T);
     return v;
   }
