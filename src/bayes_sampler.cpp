@@ -256,7 +256,7 @@ void bayes_sampler::flush_check(const row_state& row) const {
 
 void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std::vector<double>& film, double weight,
                                    int pass_spp, int spp) {
-  if (fallback || frozen || params.oracle_spp > 0 || !(params.fallback_ratio > 0) || !(weight > 0)) return;
+  if (fallback || check_done || frozen || params.oracle_spp > 0 || !(params.fallback_ratio > 0) || !(weight > 0)) return;
   size_t n = film.size() / 3;
   // Checked: passes of two spp or more, and passes of one after one (see flush_check), from 4 spp on.
   bool paired = pass_spp >= 2 || (pass_spp == 1 && px_prev.size() == n && check_pairs);
@@ -288,9 +288,10 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     bool below = valid && window_var + window_delta < params.fallback_ratio * window_var;
     fallback_votes = below ? fallback_votes + 1 : 0;
     window_var = window_delta = window_samples = 0;
-    if (fallback_votes >= 2) {
-      fallback = true;
-      fallback_spp = spp;
+    fallback = fallback_votes >= 2;
+    if (fallback) fallback_spp = spp;
+    check_done = valid && check_ratio >= 2 * params.fallback_ratio;
+    if (fallback || check_done) {
       px_var = {};
       px_delta = {};
       px_prev = {};

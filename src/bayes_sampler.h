@@ -38,6 +38,7 @@ struct bayes_sampler {
   int fallback_votes = 0;  // consecutive check windows whose ratio was below the threshold
   double window_var = 0, window_delta = 0, window_samples = 0;  // the current window's sums (see check_fallback)
   int fallback_spp = 0;    // spp rendered when it fell back (reports)
+  bool check_done = false; // a window found learning to pay by at least twice the threshold: no more checks
   double check_ratio = 0;  // the last checked pass's estimated relMSE ratio, power over learned (0: none yet)
   // Per pixel, for the fallback check of the current pass (empty while it does not run): the sum over its samples
   // of their luminance's variance, and of its NEE events' second-moment change under power sampling. Each pixel is
@@ -67,7 +68,8 @@ struct bayes_sampler {
   // (pixel weights from `film`, sum_i w_i x_i over `weight` in RGB, which includes the pass); falls back when it was
   // below the threshold in two check windows in a row. Checked: passes that end at 4 spp or more, of two spp or more
   // (a pixel's variance from its own samples) or of one spp after one (from the pair); a window sums checked passes
-  // until they hold bayes_params::fallback_window samples. `pass_spp`: the pass's spp, `spp`: the total after it.
+  // until they hold bayes_params::fallback_window samples. A window whose ratio is at least twice the threshold ends
+  // the checks (learning pays; it only improves). `pass_spp`: the pass's spp, `spp`: the total after it.
   // The check's columns are sized for the film's pixels.
   void check_fallback(const std::vector<row_state>& rows, const std::vector<double>& film, double weight,
                       int pass_spp, int spp);

@@ -149,6 +149,7 @@ void write_sampler(writer& w, const light_sampler& ls) {
     w.value(b->check_ratio);
     w.value(b->window_var), w.value(b->window_delta), w.value(b->window_samples);
     w.value(uint8_t(b->check_pairs));
+    w.value(uint8_t(b->check_done));
     w.value(uint64_t(b->px_var.size()));
     w.column(b->px_prev);
   }
@@ -190,6 +191,7 @@ void read_sampler(reader& r, light_sampler& ls) {
     b->check_ratio = r.value<double>();
     b->window_var = r.value<double>(), b->window_delta = r.value<double>(), b->window_samples = r.value<double>();
     b->check_pairs = r.value<uint8_t>() != 0;
+    b->check_done = r.value<uint8_t>() != 0;
     uint64_t checked = r.value<uint64_t>();
     b->px_prev = r.column<float>();
     if (b->fallback_votes < 0 || b->fallback_spp < 0 || !std::isfinite(b->check_ratio) || checked > (uint64_t(1) << 40) ||

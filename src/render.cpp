@@ -143,6 +143,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     if (result.spp == 0) {
       sampler.px_var = sampler.px_delta = sampler.px_prev = {};
       sampler.fallback_votes = 0;
+      sampler.check_done = false;
       sampler.window_var = sampler.window_delta = sampler.window_samples = 0;
       sampler.check_pairs = false;
     }

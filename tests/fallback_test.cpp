@@ -156,6 +156,22 @@ TEST_CASE("the fallback decision needs two checked passes in a row below the thr
   CHECK(w.fallback);
   CHECK(w.fallback_spp == 14);
 
+  // A window at twice the threshold or more ends the checks: no columns, no more votes.
+  bayes_sampler c = two_light_sampler(1.25);
+  c.check_fallback(rows, film, 1.0, 2, 2);
+  end_pass(c, {1, 3}, {1.0f, 3.0f}, film, 2, 4);  // ratio 2.0 < 2.5: checks go on
+  CHECK_FALSE(c.check_done);
+  CHECK(c.px_var.size() == 2);
+  end_pass(c, {1, 3}, {2.0f, 6.0f}, film, 2, 6);  // ratio 3.0
+  CHECK(c.check_done);
+  CHECK(c.px_var.empty());
+  CHECK(c.px_delta.empty());
+  c.px_var = {1, 3}, c.px_delta = {0, 0};  // (what a pass could not have written)
+  c.check_fallback(rows, film, 1.0, 2, 8);
+  c.check_fallback(rows, film, 1.0, 2, 10);
+  CHECK_FALSE(c.fallback);
+  CHECK(c.check_ratio == Approx(3.0).epsilon(1e-6));
+
   // Ratio 0 never falls back; nor does a frozen (oracle) sampler.
   for (int mode = 0; mode < 2; mode++) {
     bayes_sampler u = two_light_sampler(mode == 0 ? 0.0 : 1.25);
