@@ -55,8 +55,8 @@ inline uint64_t sample_key(uint64_t seed, uint64_t pixel, uint64_t sample) {
 // Uniform float in [0, 1) from the top 24 bits of a 32-bit draw (exactly representable).
 inline float uint_to_unit(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
 
-// The block of uniforms of path vertex `vertex` (0 = camera) of the sample with key `key`: its first `count`
-// dimensions (the same values as the whole block's; the rest are left unset), e.g. 2 for the camera vertex.
+// The block of uniforms of path vertex `vertex` (1 = the first hit; the camera's jitter is pixel_jitter's) of the
+// sample with key `key`: its first `count` dimensions (the same values as the whole block's; the rest left unset).
 inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex, int count = dims_per_vertex) {
   pcg32 rng(key, vertex);
   vertex_randoms r;
