@@ -250,3 +250,26 @@ TEST_CASE("a render that falls back is deterministic and resumes to the same byt
     CHECK(read_file(out) == read_file(one));
   }
 }
+
+TEST_CASE("a render whose check ended resumes with it ended", "[fallback]") {
+  // The living room at 320 x 240: the first window (spp 4-7) finds learning paying far beyond 2.5x and ends the
+  // checks. Were that not restored, the resumed run would check a second window (spp 8-12) and report its ratio.
+  temp_dir d;
+  std::string base =
+      "render " + source_path("data/living_room/direct.json") + " --width 320 --height 240 --spp 15 -o " + (d / "a.pfm");
+  auto full = run_bayeslight(base);
+  REQUIRE(full.status == 0);
+  auto ratio_of = [](const std::string& out) {
+    size_t at = out.find("learning estimated to cut relMSE per sample ");
+    return at == std::string::npos ? std::string() : out.substr(at, out.find('x', at + 45) - at);
+  };
+  std::string expected = ratio_of(full.output);
+  INFO(full.output);
+  REQUIRE_FALSE(expected.empty());
+  std::string ck = d / "ck.bin";
+  CHECK(run_bayeslight(base + " --checkpoint " + ck + " --stop-after-passes 8").status == 130);
+  auto resumed = run_bayeslight(base + " --resume " + ck);
+  INFO(resumed.output);
+  REQUIRE(resumed.status == 0);
+  CHECK(ratio_of(resumed.output) == expected);
+}
