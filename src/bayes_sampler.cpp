@@ -244,7 +244,7 @@ void bayes_sampler::sample_done(row_state& row, int pixel, vec3f l) const {
 void bayes_sampler::flush_check(const row_state& row) const {
   size_t i = size_t(row.check_pixel);
   if (row.check_n >= 2) {
-    px_var[i] = float(row.check_m2 * row.check_n / (row.check_n - 1));  // n s^2, s^2 the unbiased sample variance
+    px_var[i] = float(row.check_pending());
     return;
   }
   // One sample in this pass: half the squared difference to the pixel's sample of the pass before (both passes of
@@ -252,6 +252,13 @@ void bayes_sampler::flush_check(const row_state& row) const {
   float y = float(row.check_mean);
   px_var[i] = std::isfinite(px_prev[i]) ? 0.5f * (y - px_prev[i]) * (y - px_prev[i]) : 0.0f;
   px_prev[i] = y;
+}
+
+void bayes_sampler::restart_check() {
+  px_var = px_delta = px_prev = {};
+  fallback_votes = 0;
+  check_done = check_pairs = false;
+  window_var = window_delta = window_samples = 0;
 }
 
 void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std::vector<double>& film, double weight,

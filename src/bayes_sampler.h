@@ -39,7 +39,7 @@ struct bayes_sampler {
   double window_var = 0, window_delta = 0, window_samples = 0;  // the current window's sums (see check_fallback)
   int fallback_spp = 0;    // spp rendered when it fell back (reports)
   bool check_done = false; // a window found learning to pay by at least twice the threshold: no more checks
-  double check_ratio = 0;  // the last checked pass's estimated relMSE ratio, power over learned (0: none yet)
+  double check_ratio = 0;  // the last window's estimated relMSE ratio, power over learned (0: none yet)
   // Per pixel, for the fallback check of the current pass (empty while it does not run): the sum over its samples
   // of their luminance's variance, and of its NEE events' second-moment change under power sampling. Each pixel is
   // written by the one task rendering its row (no races), and summed in pixel order.
@@ -47,6 +47,8 @@ struct bayes_sampler {
   mutable std::vector<float> px_prev;  // passes of one spp: each pixel's sample luminance in the pass before (NaN: none)
   bool check_pairs = false;            // the last pass had one spp: px_prev holds its samples
   void flush_check(const row_state& row) const;
+  // Forgets the check's state (a new frame: its film starts empty); the fallback itself stays.
+  void restart_check();
 
   void locate(context& ctx, const shade_point& sp) const {
     if (!fallback) locate_region(ctx, regions, sp);

@@ -47,7 +47,7 @@ struct bayes_params {
                                  // its fine regions), so a new fine region starts from what its surroundings learned
   double fallback_ratio = 1.25;  // fall back to power sampling for the rest of the render when the estimated relMSE
                                  // per sample of power sampling is below this many times the learned one's in two
-                                 // checked passes in a row (from 4 spp on): where learning cannot pay for its own
+                                 // check windows in a row (from 4 spp on): where learning cannot pay for its own
                                  // cost (bayes costs 1.4-2.6x power's time per sample on the data/ scenes); 0: never
   double fallback_window = 262144;  // samples (pixels x spp) a fallback check sums before it votes: the events that
                                     // make power sampling bad can be rare (points by a lamp's rim)

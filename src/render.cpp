@@ -140,13 +140,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   const double weighting = adapts(sampler) ? params.pass_weighting : 0.0;
   if constexpr (std::is_same_v<Sampler, bayes_sampler>) {
     // The fallback check starts afresh with each frame (its first pass is not checked).
-    if (result.spp == 0) {
-      sampler.px_var = sampler.px_delta = sampler.px_prev = {};
-      sampler.fallback_votes = 0;
-      sampler.check_done = false;
-      sampler.window_var = sampler.window_delta = sampler.window_samples = 0;
-      sampler.check_pairs = false;
-    }
+    if (result.spp == 0) sampler.restart_check();
   }
   std::vector<double> pass_sum(n, 0.0);
   using rows_type = std::conditional_t<Sampler::learns, pass_rows<Sampler>, pass_rows_none>;
