@@ -88,7 +88,7 @@ TEST_CASE("the fallback check sums what its definitions say", "[fallback]") {
   CHECK(t.px_var[1] == 0.0f);
 }
 
-TEST_CASE("the fallback decision needs two checked passes in a row below the threshold", "[fallback]") {
+TEST_CASE("the fallback decision needs two check windows in a row below the threshold", "[fallback]") {
   // Pixel 0 black (relMSE weight 100), pixel 1 of luminance 1 (weight 1 / 1.01).
   std::vector<double> film = {0, 0, 0, 1, 1, 1};
   const double w0 = 100, w1 = 1 / 1.01;
@@ -97,24 +97,27 @@ TEST_CASE("the fallback decision needs two checked passes in a row below the thr
     return (var + w0 * double(float(d0)) + w1 * double(float(d1))) / var;
   };
   std::vector<bayes_row> rows(1);
+  // Passes whose sums give the ratio 1.099 (below the threshold 1.25) and 2.0 (above it).
+  auto below = [&](bayes_sampler& x, int pass_spp, int spp) { end_pass(x, {1, 3}, {0.1f, 0.2f}, film, pass_spp, spp); };
+  auto above = [&](bayes_sampler& x, int pass_spp, int spp) { end_pass(x, {1, 3}, {1.0f, 3.0f}, film, pass_spp, spp); };
 
   bayes_sampler s = two_light_sampler(1.25);
   s.check_fallback(rows, film, 1.0, 1, 1);
   // Below the threshold (1.1), but before 4 spp: not counted.
-  end_pass(s, {1, 3}, {0.1f, 0.2f}, film, 2, 3);
+  below(s, 2, 3);
   CHECK(s.fallback_votes == 0);
   CHECK_FALSE(s.fallback);
-  end_pass(s, {1, 3}, {0.1f, 0.2f}, film, 2, 5);
+  below(s, 2, 5);
   CHECK(s.check_ratio == Approx(ratio(1, 3, 0.1, 0.2)).epsilon(1e-6));
   CHECK(s.fallback_votes == 1);
   CHECK_FALSE(s.fallback);
   // Above it (2.0): the count starts again.
-  end_pass(s, {1, 3}, {1.0f, 3.0f}, film, 2, 7);
+  above(s, 2, 7);
   CHECK(s.check_ratio == Approx(2.0).epsilon(1e-6));
   CHECK(s.fallback_votes == 0);
-  end_pass(s, {1, 3}, {0.1f, 0.2f}, film, 2, 9);
+  below(s, 2, 9);
   CHECK_FALSE(s.fallback);
-  end_pass(s, {1, 3}, {0.1f, 0.2f}, film, 3, 12);
+  below(s, 3, 12);
   CHECK(s.fallback);
   CHECK(s.fallback_spp == 12);
   CHECK(s.px_var.empty());  // nothing more is checked or recorded
@@ -129,37 +132,37 @@ TEST_CASE("the fallback decision needs two checked passes in a row below the thr
   CHECK(t.fallback_votes == 0);
   end_pass(t, {1, 3}, {INFINITY, 0}, film, 2, 7);
   CHECK(t.fallback_votes == 0);
-  end_pass(t, {1, 3}, {0.1f, 0.2f}, film, 2, 9);
+  below(t, 2, 9);
   CHECK(t.fallback_votes == 1);
-  end_pass(t, {1, 3}, {0.1f, 0.2f}, film, 1, 10);  // neither counts nor resets
+  below(t, 1, 10);  // neither counts nor resets
   CHECK(t.fallback_votes == 1);
   CHECK_FALSE(t.fallback);
-  end_pass(t, {1, 3}, {0.1f, 0.2f}, film, 2, 12);
+  below(t, 2, 12);
   CHECK(t.fallback);
 
   // Windows: with 2 pixels and a window of 8 samples, passes of 2 spp vote every second pass, on their summed ratio.
   bayes_sampler w = two_light_sampler(1.25, 8);
   w.check_fallback(rows, film, 1.0, 2, 2);
-  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 4);
+  below(w, 2, 4);
   CHECK(w.check_ratio == 0);  // half a window: no vote yet
   CHECK(w.window_samples == 4);
-  end_pass(w, {1, 3}, {1.0f, 3.0f}, film, 2, 6);
+  above(w, 2, 6);
   CHECK(w.window_samples == 0);
   CHECK(w.check_ratio == Approx(ratio(2, 6, 1.1, 3.2)).epsilon(1e-6));  // (1.099 + 2) / 2: above the threshold
   CHECK(w.fallback_votes == 0);
-  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 8);
-  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 10);
+  below(w, 2, 8);
+  below(w, 2, 10);
   CHECK(w.fallback_votes == 1);
-  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 12);
+  below(w, 2, 12);
   CHECK_FALSE(w.fallback);
-  end_pass(w, {1, 3}, {0.1f, 0.2f}, film, 2, 14);
+  below(w, 2, 14);
   CHECK(w.fallback);
   CHECK(w.fallback_spp == 14);
 
   // A window at twice the threshold or more ends the checks: no columns, no more votes.
   bayes_sampler c = two_light_sampler(1.25);
   c.check_fallback(rows, film, 1.0, 2, 2);
-  end_pass(c, {1, 3}, {1.0f, 3.0f}, film, 2, 4);  // ratio 2.0 < 2.5: checks go on
+  above(c, 2, 4);  // ratio 2.0 < 2.5: checks go on
   CHECK_FALSE(c.check_done);
   CHECK(c.px_var.size() == 2);
   end_pass(c, {1, 3}, {2.0f, 6.0f}, film, 2, 6);  // ratio 3.0
