@@ -366,7 +366,7 @@ void bayes_sampler::add_pairs(int first_region) {
 void bayes_sampler::rebuild_posterior() {
   size_t n = stats.m.size();
   stats.coeffs.resize(n);
-  stats.weight.resize(n);
+  stats.weight.resize(params.region_prior ? 0 : n);
   stats.mu0.assign(n, 0.0f);
   stats.w.assign(n + 4, 0.0f);
   add_pairs(0);

@@ -16,7 +16,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   size_t old = s.m.size(), n = size_t(pairs);
   s.m.resize(n);
   s.coeffs.resize(n);
-  s.weight.resize(n);
+  s.weight.resize(p.region_prior ? 0 : n);
   s.mu0.resize(n, 0.0f);
   s.w.resize(n + 4, 0.0f);
   s.w_cv.resize(n + 4, 0.0f);
@@ -27,7 +27,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
     fold_weight(s, old, invalid_id, p);
     for (size_t i = old + 1; i < n; i++) {
       s.coeffs[i] = s.coeffs[old];
-      s.weight[i] = s.weight[old];
+      if (!p.region_prior) s.weight[i] = s.weight[old];
       s.w[i] = s.w[old];
       s.w_cv[i] = s.w_cv[old];
       s.cv[i] = s.cv[old];
@@ -147,7 +147,7 @@ void bayes_row::add_at(int index, double z) {
 
 void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p) {
   // Every pair independently (the result does not depend on how the range is split).
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, s.weight.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, s.m.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); i++) {
       int up = parents ? (*parents)[i] : invalid_id;
       fold_weight(s, i, up, p);

@@ -92,7 +92,8 @@ struct merge_buffers {
 struct bayes_stats {
   std::vector<pair_moments> m;           // statistics: read and written between passes only
   std::vector<pair_coeffs> coeffs;       // posterior per pair without the hierarchy (between passes only)
-  std::vector<pair_weight> weight;       // read by every shading point (point-prior mode)
+  std::vector<pair_weight> weight;       // point-prior mode: read by every shading point (empty in region-prior mode,
+                                         // whose points read `w`, a function of these and mu0)
   std::vector<float> mu0;                // region-prior mode: the pair's prior mean of z (set with its region)
   std::vector<float> w;                  // region-prior mode: W per pair (+ 4 padding entries for SSE loads)
   std::vector<float> w_cv, cv;           // control variates: W of the residual, and E[1 - p0] k (+ 4 padding each)
@@ -136,15 +137,21 @@ inline double prior_mean(const bayes_stats& s, size_t i, int up, const bayes_par
   if (up < 0 || !uses_mean_hierarchy(p)) return mu0;
   return std::min(mu0, own_posterior_mean(s, size_t(up), p));
 }
+// Pair i's coefficients with p1 folded in: what a shading point evaluates in point-prior mode.
+inline pair_weight folded_coeffs(const bayes_stats& s, size_t i, double p1) {
+  const pair_coeffs& c = s.coeffs[i];
+  return {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
+}
 // Folds pair i's p1 (and, under the mean hierarchy, its parent's mean) into its sampling weight.
 inline double eval_weight(const pair_weight& h, const bayes_params& p, double v, double g);
 inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
   double p1 = pair_p1(s, i, up, p);
   if (up >= 0) s.p1_folded[i] = float(p1);  // a child: the p1 its weight now holds (see bayes_sampler::refold)
-  const pair_coeffs& c = s.coeffs[i];
-  pair_weight pw = {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
-  s.weight[i] = pw;  // read by every shading point in point-prior mode (and by the tests)
-  if (!p.region_prior) return;
+  pair_weight pw = folded_coeffs(s, i, p1);
+  if (!p.region_prior) {
+    s.weight[i] = pw;  // read by every shading point in point-prior mode
+    return;
+  }
   // With v = mu0 g the weight is g times its value at g = 1 (see pair_coeffs): W = eval_weight(v = mu0, g = 1).
   double mu0 = prior_mean(s, i, up, p);
   s.w[i] = float(eval_weight(pw, p, mu0, 1.0));
@@ -160,6 +167,16 @@ inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p)
   // Residual second moment E[(Z - c)^2] with c = p1 k: p1 (k^2 + h) - p1^2 k^2 = p1 h + p1 (1 - p1) k^2.
   s.w_cv[i] = float(std::sqrt(p1 * h + p1 * (1 - p1) * k * k));
   s.cv[i] = float(p1 * k);
+}
+// Whether what sampling reads of pair i (its coefficients, and its weight columns where the mode keeps them) is finite.
+inline bool pair_state_finite(const bayes_stats& s, size_t i) {
+  bool ok = std::isfinite(s.coeffs[i].p1);
+  if (i < s.weight.size()) {
+    const pair_weight& x = s.weight[i];
+    ok = ok && std::isfinite(x.w2) && std::isfinite(x.w1) && std::isfinite(x.w0) && std::isfinite(x.wc);
+  }
+  if (i < s.w.size()) ok = ok && std::isfinite(s.w[i]) && std::isfinite(s.w_cv[i]) && std::isfinite(s.cv[i]);
+  return ok;
 }
 // Folds every pair's p1 into its weight (parents: region_state::pair_parent, or nullptr for none): the sweep
 // that ends learning between passes.

@@ -15,8 +15,9 @@ namespace bl {
 namespace {
 
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
-constexpr uint32_t version = 6;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
-                                 // 5: mean hierarchy (k_folded); 6: bayes fallback check
+constexpr uint32_t version = 7;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
+                                 // 5: mean hierarchy (k_folded); 6: bayes fallback check; 7: no point-prior
+                                 // weights in region-prior mode
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -172,7 +173,7 @@ void read_sampler(reader& r, light_sampler& ls) {
       std::vector<double> col = r.column<double>(pairs);
       for (size_t i = 0; i < pairs; i++) moment_field(b->stats.m[i], f) = col[i];
     }
-    std::vector<pair_weight> weight = r.column<pair_weight>(pairs);
+    std::vector<pair_weight> weight = r.column<pair_weight>(b->params.region_prior ? 0 : pairs);
     std::vector<float> wcol = r.column<float>(pairs + 4), w_cv = r.column<float>(pairs + 4),
                        cv = r.column<float>(pairs + 4), p1_folded = r.column<float>(pairs),
                        k_folded = r.column<float>(pairs);

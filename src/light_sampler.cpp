@@ -125,11 +125,21 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
   throw usage_error(std::string("sampler \"") + sampler_name(params.kind) + "\" is not available in this build");
 }
 
+template <typename T>
+static size_t bytes_of(const std::vector<T>& v) {
+  return v.size() * sizeof(T);
+}
+
 size_t sampler_memory_bytes(const light_sampler& s) {
   if (auto* b = std::get_if<bound_sampler>(&s)) return region_memory_bytes(b->regions);
-  if (auto* b = std::get_if<bayes_sampler>(&s))
-    return region_memory_bytes(b->regions) + b->stats.m.size() * (sizeof(pair_moments) + sizeof(pair_coeffs) + sizeof(pair_weight) + 5 * sizeof(float) + 2 * sizeof(int)) +
-           (b->px_var.size() + b->px_delta.size() + b->px_prev.size()) * sizeof(float);
+  if (auto* b = std::get_if<bayes_sampler>(&s)) {
+    // Every column the sampler keeps per pair (and the fallback check's per pixel), as allocated.
+    const bayes_stats& st = b->stats;
+    return region_memory_bytes(b->regions) + bytes_of(st.m) + bytes_of(st.coeffs) + bytes_of(st.weight) +
+           bytes_of(st.mu0) + bytes_of(st.w) + bytes_of(st.w_cv) + bytes_of(st.cv) + bytes_of(st.p1_folded) +
+           bytes_of(st.k_folded) + bytes_of(b->first_child) + bytes_of(b->next_sibling) + bytes_of(b->px_var) +
+           bytes_of(b->px_delta) + bytes_of(b->px_prev);
+  }
   if (auto* d = std::get_if<donikian_sampler>(&s))
     return region_memory_bytes(d->deeper.regions) +
            (d->pixel_sum.size() + d->pixel_count.size() + d->block_sum.size() + d->block_count.size()) * sizeof(float);

@@ -56,11 +56,11 @@ inline uint64_t sample_key(uint64_t seed, uint64_t pixel, uint64_t sample) {
 inline float uint_to_unit(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
 
 // The block of uniforms of path vertex `vertex` (1 = the first hit; the camera's jitter is pixel_jitter's) of the
-// sample with key `key`: its first `count` dimensions (the same values as the whole block's; the rest left unset).
-inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex, int count = dims_per_vertex) {
+// sample with key `key`.
+inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex) {
   pcg32 rng(key, vertex);
   vertex_randoms r;
-  for (int i = 0; i < count; i++) {
+  for (int i = 0; i < dims_per_vertex; i++) {
     r.raw[i] = rng();
     r.u[i] = uint_to_unit(r.raw[i]);
   }

@@ -22,6 +22,12 @@ using namespace bl::test;
 
 namespace {
 
+// A parentless pair's coefficients with its p1 folded in: what a point-prior shading point evaluates (region-prior
+// mode, the default, folds them further into `w` and keeps no such column).
+pair_weight weight_of(const bayes_stats& s, size_t i) {
+  return folded_coeffs(s, i, s.coeffs[i].p1);
+}
+
 double unif(pcg32& r) {
   return (double(r() >> 5) * 67108864.0 + double(r() >> 6)) * (1.0 / 9007199254740992.0);
 }
@@ -345,7 +351,7 @@ TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes
       for (int k = 0; k < 20; k++) {
         double bound = log_uniform(rng, 1e-8, 1e8), scale = log_uniform(rng, 0.01, 1), d = log_uniform(rng, 1e-3, 1e3);
         double v = scale * bound, g = 1 / (d * d);
-        double fast = eval_weight(s.weight[size_t(i)], p, v, g);
+        double fast = eval_weight(weight_of(s, size_t(i)), p, v, g);
         double ref =
             posterior_weight(p, bound, scale, d, s.m[size_t(i)].n0, s.m[size_t(i)].n1, s.m[size_t(i)].mean, s.m[size_t(i)].m2);
         double e = ref == 0 ? std::fabs(fast) : rel_err(fast, ref);
@@ -363,15 +369,15 @@ TEST_CASE("prior only weights are proportional to the bound", "[bayes]") {
     bayes_stats s;
     resize_stats(s, 5, p);
     pcg32 rng(41, 3);
-    double ratio = eval_weight(s.weight[0], p, 1.0, 1.0);
+    double ratio = eval_weight(weight_of(s, 0), p, 1.0, 1.0);
     CHECK(ratio > 0);
     for (int k = 0; k < 200; k++) {
       double v = log_uniform(rng, 1e-10, 1e10), g = log_uniform(rng, 1e-6, 1e6);
-      CHECK(rel_err(eval_weight(s.weight[size_t(k % 5)], p, v, g), ratio * v) < 1e-12);
+      CHECK(rel_err(eval_weight(weight_of(s, size_t(k % 5)), p, v, g), ratio * v) < 1e-12);
       double d = 1 / std::sqrt(g);
       CHECK(rel_err(posterior_weight(p, v, 1.0, d, 0, 0, 0, 0), ratio * v) < 1e-6);  // float coefficient
     }
-    CHECK(eval_weight(s.weight[0], p, 0.0, 1.0) == 0);
+    CHECK(eval_weight(weight_of(s, 0), p, 0.0, 1.0) == 0);
   }
 }
 
@@ -554,7 +560,7 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
       // The coefficients were refreshed from the merged statistics.
       double ref =
           posterior_weight(p, 2.0, 0.3, 1.5, s.m[size_t(i)].n0, s.m[size_t(i)].n1, s.m[size_t(i)].mean, s.m[size_t(i)].m2);
-      CHECK(rel_err(eval_weight(s.weight[size_t(i)], p, 0.6, 1 / 2.25), ref) < 1e-5);
+      CHECK(rel_err(eval_weight(weight_of(s, size_t(i)), p, 0.6, 1 / 2.25), ref) < 1e-5);
     }
   }
 }
@@ -574,7 +580,7 @@ TEST_CASE("decaying statistics scales the counts and keeps the mean", "[bayes]")
   CHECK(s.m[1].n1 == 1.5);
   CHECK(s.m[1].mean == mean);
   CHECK(s.m[1].m2 == 0.5 * m2);
-  CHECK(rel_err(eval_weight(s.weight[1], p, 0.2, 0.5),
+  CHECK(rel_err(eval_weight(weight_of(s, 1), p, 0.2, 0.5),
                 posterior_weight(p, 0.2, 1.0, std::sqrt(2.0), 1.0, 1.5, mean, 0.5 * m2)) < 1e-5);
 }
 
@@ -904,8 +910,9 @@ TEST_CASE("under the mean hierarchy a fine pair's prior mean is the lower of its
     REQUIRE(k_parent < 0.1 * s.stats.mu0[base]);
     double expect = means ? std::min(double(s.stats.mu0[base]), k_parent) : double(s.stats.mu0[base]);
     CHECK(prior_mean(s.stats, base, int(cbase), s.params) == Approx(expect).epsilon(1e-12));
-    double w_expect = eval_weight(s.stats.weight[base], s.params, expect, 1.0);
-    double w_bound = eval_weight(s.stats.weight[base], s.params, s.stats.mu0[base], 1.0);
+    pair_weight pw = folded_coeffs(s.stats, base, pair_p1(s.stats, base, int(cbase), s.params));
+    double w_expect = eval_weight(pw, s.params, expect, 1.0);
+    double w_bound = eval_weight(pw, s.params, s.stats.mu0[base], 1.0);
     CHECK(s.stats.w[base] == Approx(w_expect).epsilon(1e-6));
     if (means) CHECK(w_expect < 0.5 * w_bound);  // decisive: the parent's mean pulls the fine weight down
     CHECK(std::isfinite(s.stats.w[base]));

@@ -389,9 +389,7 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
           for (size_t i = 0; i < b->stats.m.size(); i++) {
             n += b->stats.m[i].n0 + b->stats.m[i].n1;
             finite = finite && std::isfinite(b->stats.m[i].mean) && std::isfinite(b->stats.m[i].m2) &&
-                     std::isfinite(b->stats.weight[i].w2) && std::isfinite(b->stats.weight[i].w1) &&
-                     std::isfinite(b->stats.weight[i].w0) && std::isfinite(b->stats.weight[i].wc) &&
-                     std::isfinite(b->stats.coeffs[i].p1);
+                     pair_state_finite(b->stats, i);
           }
           CHECK(n > 0);
           CHECK(finite);

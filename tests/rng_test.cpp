@@ -29,19 +29,6 @@ TEST_CASE("vertex blocks repeat for the same key and differ between keys and ver
   CHECK(firsts.size() > 4080);
 }
 
-TEST_CASE("a partial vertex block holds the whole block's first dimensions", "[rng]") {
-  for (uint64_t px = 0; px < 64; px++)
-    for (uint32_t v = 0; v < 3; v++)
-      for (int count = 0; count <= dims_per_vertex; count++) {
-        auto whole = draw_vertex(sample_key(5, px, 2), v);
-        auto part = draw_vertex(sample_key(5, px, 2), v, count);
-        for (int i = 0; i < count; i++) {
-          REQUIRE(part.raw[i] == whole.raw[i]);
-          REQUIRE(part.u[i] == whole.u[i]);
-        }
-      }
-}
-
 TEST_CASE("uniforms lie in the unit interval with mean one half", "[rng]") {
   // 80000 uniforms: the mean's standard error is 0.289/sqrt(80000) = 0.00102; 5 sigma bound.
   double sum = 0;

@@ -107,9 +107,7 @@ void check_bayes_state(const built_scene& b, int depth) {
     observations += s.stats.m[i].n0 + s.stats.m[i].n1;
     bool ok = std::isfinite(s.stats.m[i].n0) && std::isfinite(s.stats.m[i].n1) && std::isfinite(s.stats.m[i].mean) &&
               std::isfinite(s.stats.m[i].m2) && s.stats.m[i].m2 >= 0 && s.stats.m[i].mean >= 0 &&
-              std::isfinite(s.stats.weight[i].w2) && std::isfinite(s.stats.weight[i].w1) &&
-                     std::isfinite(s.stats.weight[i].w0) && std::isfinite(s.stats.weight[i].wc) &&
-                     std::isfinite(s.stats.coeffs[i].p1);
+              pair_state_finite(s.stats, i);
     if (!ok) bad++;
   }
   INFO("pairs " << s.stats.m.size() << " observations " << observations);
