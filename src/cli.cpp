@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cctype>
 #include <chrono>
 #include <climits>
@@ -136,14 +137,9 @@ std::string frame_path(const std::string& pattern, int frame) {
   return buf;
 }
 
-// Reads a reference image and checks its size.
+// Reads a reference image of the render's size.
 image_data load_reference(const std::string& path, const render_params& params) {
-  image_data ref = read_image(path);
-  if (ref.width != params.width || ref.height != params.height)
-    throw input_error(path, "reference is " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
-                                " but the render is " + std::to_string(params.width) + "x" +
-                                std::to_string(params.height));
-  return ref;
+  return read_reference(path, params.width, params.height);
 }
 
 int run_render(const render_options& o) {
@@ -180,9 +176,7 @@ int run_render(const render_options& o) {
   for (const image_data& r : references) params.frame_references.push_back(&r);
   auto t_load = std::chrono::steady_clock::now();
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
-  if (scene.mesh.dropped_degenerate > 0)
-    std::fprintf(stderr, "%s: dropped %d degenerate (zero-area) triangles\n", desc.mesh_path.c_str(),
-                 scene.mesh.dropped_degenerate);
+  report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
   auto t_bvh = std::chrono::steady_clock::now();
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
@@ -266,8 +260,18 @@ void add_render_options(CLI::App* r, render_options& o) {
       ->check(CLI::Range(1, 1000));
   r->add_option("--threads", o.threads, "Worker threads (default: all cores); never changes the image")
       ->check(CLI::Range(1, 4096));
-  r->add_option_function<uint64_t>("--seed", [&o](const uint64_t& s) { o.seed = s, o.has_seed = true; },
-                                   "Random seed (default: the scene's render.seed)");
+  r->add_option_function<std::string>(
+      "--seed",
+      [&o](const std::string& s) {
+        // Digits only, within 64 bits (a conversion would wrap "-1" and saturate 2^64 without a word).
+        errno = 0;
+        char* end = nullptr;
+        unsigned long long v = s.empty() || s[0] < '0' || s[0] > '9' ? 0 : std::strtoull(s.c_str(), &end, 10);
+        if (end == nullptr || *end != '\0' || errno == ERANGE)
+          throw CLI::ValidationError("--seed", "must be an integer from 0 to 18446744073709551615 (got " + s + ")");
+        o.seed = uint64_t(v), o.has_seed = true;
+      },
+      "Random seed, 0 to 2^64 - 1 (default: the scene's render.seed)");
   r->add_option("--width", o.width, "Image width in pixels")->check(CLI::Range(1ll, max_side));
   r->add_option("--height", o.height, "Image height in pixels")->check(CLI::Range(1ll, max_side));
   r->add_flag("--quiet", o.quiet, "No progress bar or summary");
@@ -459,7 +463,7 @@ int run_cli(int argc, char** argv) {
   std::string first = argc >= 2 ? argv[1] : "";
   if (!first.empty() && first[0] != '-' && first != "render" && first != "diff" && first != "compare" &&
       first != "profile") {
-    std::fprintf(stderr, "bayeslight: error: unknown command \"%s\" (commands: render, diff, compare)\n"
+    std::fprintf(stderr, "bayeslight: error: unknown command \"%s\" (commands: render, compare, profile, diff)\n"
                          "Run with --help for more information.\n", first.c_str());
     return exit_usage;
   }

@@ -6,6 +6,7 @@
 
 #include "errors.h"
 #include "file_io.h"
+#include "report.h"
 #include "svg_plot.h"
 
 #include <unistd.h>
@@ -246,15 +247,9 @@ static void make_output_dir(const std::string& dir) {
 
 int run_compare(const scene_desc& desc, const compare_params& params) {
   const render_params& rp = params.render;
-  image_data reference = read_image(params.reference_path);
-  if (reference.width != rp.width || reference.height != rp.height)
-    throw input_error(params.reference_path, "reference is " + std::to_string(reference.width) + "x" +
-                                                 std::to_string(reference.height) + " but the render is " +
-                                                 std::to_string(rp.width) + "x" + std::to_string(rp.height));
+  image_data reference = read_reference(params.reference_path, rp.width, rp.height);
   scene_data scene = build_scene(desc, float(rp.width) / float(rp.height));
-  if (scene.mesh.dropped_degenerate > 0)
-    std::fprintf(stderr, "%s: dropped %d degenerate (zero-area) triangles\n", desc.mesh_path.c_str(),
-                 scene.mesh.dropped_degenerate);
+  report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
   if (lights.count == 0)

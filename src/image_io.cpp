@@ -366,4 +366,18 @@ void write_image(const std::string& path, const image_data& img) {
   throw output_error("cannot write " + path + ": unknown image format (expected .exr, .pfm or .png)");
 }
 
+image_data read_reference(const std::string& path, int width, int height) {
+  image_data ref = read_image(path);
+  if (ref.width != width || ref.height != height)
+    throw input_error(path, "reference is " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
+                                " but the render is " + std::to_string(width) + "x" + std::to_string(height));
+  for (size_t i = 0; i < ref.pixels.size(); i++)
+    if (!std::isfinite(ref.pixels[i])) {
+      size_t px = i / 3;
+      throw input_error(path, "reference has a non-finite value at pixel (" + std::to_string(px % size_t(width)) +
+                                  ", " + std::to_string(px / size_t(width)) + ")");
+    }
+  return ref;
+}
+
 }  // namespace bl

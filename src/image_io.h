@@ -20,6 +20,9 @@ image_format image_format_of(const std::string& path);
 
 // Reads an .exr or .pfm image; throws input_error naming the file on any problem.
 image_data read_image(const std::string& path);
+// Reads a reference image for a render of width x height: its size must match and every value be finite (a
+// NaN would make every error figure NaN); throws input_error naming the file otherwise.
+image_data read_reference(const std::string& path, int width, int height);
 // Writes by extension (.exr fp32, .pfm, .png sRGB 8-bit clamped); atomic; throws output_error on failure.
 void write_image(const std::string& path, const image_data& img);
 

@@ -278,6 +278,7 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
   mtl_material_data* cur = nullptr;
   size_t first = out.size();
   std::vector<char> has_kd;  // per material of this file: a Kd statement was seen
+  size_t transparent_line = 0;  // the first d or Tr statement asking for partial transparency (reported once)
   while (lines.next(line)) {
     text_pos pos{path, lines.line};
     tokenize(line, pos, t);
@@ -316,8 +317,12 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       if (k == "Ns" && v < 0) fail(pos, "Ns must not be negative");
       if ((k == "d" || k == "Tr") && !(v >= 0 && v <= 1)) fail(pos, quote(k) + " must lie in [0, 1]");
       if (k == "Ns") m.ns = v;
+      if (((k == "d" && v < 1) || (k == "Tr" && v > 0)) && transparent_line == 0) transparent_line = lines.line;
     }
   }
+  if (transparent_line > 0)
+    std::cerr << "warning: " << path << ":" << transparent_line
+              << ": dissolve (d below 1 or Tr above 0) is not rendered, surfaces stay opaque; map_d cuts out\n";
   // A map_Kd without Kd shows the texture as it is (Kd multiplies the texture, as the MTL format says).
   for (size_t i = first; i < out.size(); i++)
     if (!out[i].kd_map.empty() && !has_kd[i - first]) out[i].material.kd = {1, 1, 1};

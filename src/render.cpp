@@ -5,6 +5,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
 #include <atomic>
@@ -150,6 +151,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   if constexpr (Sampler::learns) rows.records.resize(size_t((h + rows_per_band<Sampler>() - 1) / rows_per_band<Sampler>()));
 
   int threads = params.threads > 0 ? params.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  // More threads than cores are allowed when asked for (TBB's default limit would warn and ignore them).
+  tbb::global_control allow(tbb::global_control::max_allowed_parallelism, size_t(threads));
   tbb::task_arena arena(threads);
   progress_counters progress;
   progress.spp_target = params.time_budget > 0 ? 0 : params.spp;

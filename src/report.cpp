@@ -31,8 +31,8 @@ std::string render_summary(const render_result& r, const std::vector<std::string
   const path_stats& st = r.stats;
   double rays = double(st.camera_rays + st.shadow_rays + st.bounce_rays);
   char buf[512];
-  std::snprintf(buf, sizeof buf, "%s %d spp in %.2f s (%d passes, %.2f Mrays/s, %.2f M NEE samples/s)",
-                r.interrupted ? "interrupted after" : "rendered", r.spp, r.seconds, r.passes,
+  std::snprintf(buf, sizeof buf, "%s %d spp in %.2f s (%d pass%s, %.2f Mrays/s, %.2f M NEE samples/s)",
+                r.interrupted ? "interrupted after" : "rendered", r.spp, r.seconds, r.passes, r.passes == 1 ? "" : "es",
                 r.seconds > 0 ? rays / r.seconds * 1e-6 : 0.0,
                 r.seconds > 0 ? double(st.nee_samples) / r.seconds * 1e-6 : 0.0);
   std::string s = buf;
@@ -67,6 +67,12 @@ std::string render_summary(const render_result& r, const std::vector<std::string
     s += "; no pass completed, no image written";
   }
   return s;
+}
+
+void report_dropped_triangles(const std::string& mesh_path, int dropped) {
+  if (dropped > 0)
+    std::fprintf(stderr, "%s: dropped %d degenerate (zero-area) triangle%s\n", mesh_path.c_str(), dropped,
+                 dropped == 1 ? "" : "s");
 }
 
 }  // namespace bl

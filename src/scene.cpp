@@ -37,14 +37,26 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
   }
   s.scale = is_empty(s.bounds) ? 1.0f : std::max(max_abs_component(s.bounds.lo), max_abs_component(s.bounds.hi));
   if (!(s.scale > 0)) s.scale = 1;
-  s.camera = camera.automatic ? frame_bounds(s.bounds, camera.fov_y_deg, aspect) : camera;
+  s.camera = camera;
+  if (camera.automatic || camera.frame_eye || camera.frame_target) {
+    camera_params f = frame_bounds(s.bounds, camera.fov_y_deg, aspect);
+    if (!camera.frame_target) s.camera.eye = camera.frame_eye ? camera.target + (f.eye - f.target) : f.eye;
+    if (!camera.frame_eye) s.camera.target = f.target;
+  }
   s.sun = sun;
   s.two_sided_emitters = two_sided;
   return s;
 }
 
 scene_data build_scene(const scene_desc& desc, float aspect) {
-  return build_scene(load_obj(desc.mesh_path), desc.camera, desc.sun, desc.two_sided_emitters, aspect);
+  scene_data s = build_scene(load_obj(desc.mesh_path), desc.camera, desc.sun, desc.two_sided_emitters, aspect);
+  // A camera completed from the mesh bounds (scene_desc.h) can only be checked now.
+  vec3f dir = s.camera.target - s.camera.eye;
+  if (!(length(dir) > 0))
+    throw input_error(desc.path, "the camera's \"eye\" is the mesh's centre, its default \"target\": give a target");
+  if (!(length(cross(normalize(dir), normalize(s.camera.up))) > 1e-6f))
+    throw input_error(desc.path, "camera \"up\" must not be parallel to the viewing direction");
+  return s;
 }
 
 surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f dir) {

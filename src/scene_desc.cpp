@@ -13,6 +13,7 @@
 #include <initializer_list>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 namespace bl {
 
@@ -81,8 +82,9 @@ vec3f get_vec3(const desc_context& ctx, const json& v, const std::string& key) {
 void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   check_keys(ctx, j, "camera", {"eye", "target", "up", "fov_y_deg"});
   bool has_eye = j.contains("eye"), has_target = j.contains("target");
-  if (has_eye != has_target) ctx.fail("camera", "camera needs both \"eye\" and \"target\" (or neither)");
-  cam.automatic = !has_eye;
+  cam.automatic = !has_eye && !has_target;
+  cam.frame_eye = has_target && !has_eye;
+  cam.frame_target = has_eye && !has_target;
   if (has_eye) cam.eye = get_vec3(ctx, j["eye"], "eye");
   if (has_target) cam.target = get_vec3(ctx, j["target"], "target");
   if (j.contains("up")) cam.up = get_vec3(ctx, j["up"], "up");
@@ -90,9 +92,10 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   if (!(cam.fov_y_deg > 0 && cam.fov_y_deg < 179))
     ctx.fail("fov_y_deg", "\"fov_y_deg\" must be in (0, 179) degrees");
   vec3f dir = cam.target - cam.eye;
-  if (has_eye && !(length(dir) > 0)) ctx.fail("target", "camera \"eye\" and \"target\" must differ");
+  bool both = has_eye && has_target;  // otherwise checked once the mesh bounds are known (scene.cpp)
+  if (both && !(length(dir) > 0)) ctx.fail("target", "camera \"eye\" and \"target\" must differ");
   if (!(length(cam.up) > 0)) ctx.fail("up", "camera \"up\" must be a non-zero vector");
-  if (has_eye && !(length(cross(normalize(dir), normalize(cam.up))) > 1e-6f))
+  if (both && !(length(cross(normalize(dir), normalize(cam.up))) > 1e-6f))
     ctx.fail("up", "camera \"up\" must not be parallel to the viewing direction");
 }
 
@@ -150,8 +153,22 @@ scene_desc load_scene_desc(const std::string& path) {
   desc_context ctx{path, ss.str()};
 
   json root;
+  // Keys given twice in one object: nlohmann keeps the last silently, which would drop the first's settings.
+  std::vector<std::vector<std::string>> open_objects;
+  std::string duplicate;
+  auto on_event = [&](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) open_objects.emplace_back();
+    else if (event == json::parse_event_t::object_end && !open_objects.empty()) open_objects.pop_back();
+    else if (event == json::parse_event_t::key && !open_objects.empty() && duplicate.empty()) {
+      std::vector<std::string>& keys = open_objects.back();
+      const std::string& k = parsed.get_ref<const std::string&>();
+      if (std::find(keys.begin(), keys.end(), k) != keys.end()) duplicate = k;
+      keys.push_back(k);
+    }
+    return true;
+  };
   try {
-    root = json::parse(ctx.text, nullptr, true, /*ignore_comments=*/true);
+    root = json::parse(ctx.text, on_event, true, /*ignore_comments=*/true);
   } catch (const json::parse_error& e) {
     // e.byte is the 1-based offset of the offending byte; turn it into a line number.
     size_t at = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, ctx.text.size());
@@ -169,6 +186,13 @@ scene_desc load_scene_desc(const std::string& path) {
     int line = at == std::string::npos ? 0 : 1 + int(std::count(ctx.text.begin(), ctx.text.begin() + long(at), '\n'));
     size_t tag_end = msg.find("] ");
     throw input_error(path, line, "malformed JSON: " + (tag_end == std::string::npos ? msg : msg.substr(tag_end + 2)));
+  }
+  if (!duplicate.empty()) {
+    // The line of its second appearance as a quoted string (the best a callback without offsets can tell).
+    std::string quoted = "\"" + duplicate + "\"";
+    size_t first = ctx.text.find(quoted), second = first == std::string::npos ? first : ctx.text.find(quoted, first + 1);
+    int line = second == std::string::npos ? 0 : 1 + int(std::count(ctx.text.begin(), ctx.text.begin() + long(second), '\n'));
+    throw input_error(path, line, "key \"" + duplicate + "\" is given twice in one object");
   }
   check_keys(ctx, root, "the scene file", {"mesh", "camera", "image", "render", "sun", "two_sided_emitters"});
   if (!root.contains("mesh")) throw input_error(path, "missing required key \"mesh\"");
@@ -193,8 +217,9 @@ scene_desc load_scene_desc(const std::string& path) {
     if (r.contains("spp")) desc.spp = int(get_integer(ctx, r["spp"], "spp", 1, std::numeric_limits<int>::max()));
     if (r.contains("max_depth")) desc.max_depth = int(get_integer(ctx, r["max_depth"], "max_depth", 1, 1000));
     if (r.contains("seed")) {
-      if (r["seed"].is_number_unsigned()) desc.seed = r["seed"].get<uint64_t>();
-      else desc.seed = uint64_t(get_integer(ctx, r["seed"], "seed", 0, std::numeric_limits<int64_t>::max()));
+      if (!r["seed"].is_number_unsigned())
+        ctx.fail("seed", "\"seed\" must be an integer from 0 to 18446744073709551615");
+      desc.seed = r["seed"].get<uint64_t>();
     }
   }
   if (root.contains("sun")) parse_sun(ctx, root["sun"], desc.sun);

@@ -11,9 +11,12 @@
 
 namespace bl {
 
-// Pinhole camera placement; `automatic` means "frame the mesh bounds from +z" (no camera in the file).
+// Pinhole camera placement; `automatic` means "frame the mesh bounds from +z" (neither eye nor target in the file).
+// With only one of them given, the other comes from that framing: a missing target is the bounds' centre, a
+// missing eye lies on the +z side of the target at the framing distance.
 struct camera_params {
   bool automatic = true;
+  bool frame_eye = false, frame_target = false;
   vec3f eye = {0, 0, 1}, target = {0, 0, 0}, up = {0, 1, 0};
   float fov_y_deg = 45;
 };

@@ -117,6 +117,10 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --bayes-alpha0 nan", "--bayes-alpha0"},
       {"render " + s.json + " --frame-decay nan", "--frame-decay"},
       {"render " + s.json + " --checkpoint-every nan", "--checkpoint-every"},
+      // Seeds: digits within 64 bits (a conversion would wrap -1 and saturate 2^64).
+      {"render " + s.json + " --seed -1", "--seed"},
+      {"render " + s.json + " --seed 18446744073709551616", "--seed"},
+      {"render " + s.json + " --seed 1e3", "--seed"},
       {"frobnicate", "frobnicate"},
   };
   for (const auto& c : cases) {
@@ -151,6 +155,14 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
       {"nofile.json", "{\"mesh\": \"nothere.obj\"}", "nothere.obj"},
       {"badobj.json", "{\"mesh\": \"bad.obj\"}", "bad.obj:2"},
       {"scene.txt", "{}", "scene.txt"},
+      // A key given twice would silently drop the first one's settings.
+      {"twice.json", "{\"mesh\": \"box.obj\",\n \"render\": {\"spp\": 2},\n \"render\": {\"seed\": 5}}",
+       "twice.json:3: key \"render\" is given twice"},
+      {"twice_nested.json", "{\"mesh\": \"box.obj\", \"render\": {\"spp\": 2,\n \"spp\": 4}}",
+       "twice_nested.json:2: key \"spp\""},
+      // An eye without a target looks at the mesh's centre: not from the centre itself.
+      {"eye_at_centre.json", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 0]}}", "eye_at_centre.json"},
+      {"seed_range.json", "{\"mesh\": \"box.obj\", \"render\": {\"seed\": -1}}", "seed_range.json:1: \"seed\""},
   };
   write_text(s.dir / "bad.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n");
   for (const auto& c : cases) {
@@ -170,6 +182,46 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
   CHECK(!exists(s.dir / "out.exr"));
   auto d = run_bayeslight("diff " + (s.dir / "garbage.exr") + " " + (s.dir / "garbage.exr"));
   CHECK(d.status == 3);
+  // A reference with a NaN (every error figure would be NaN).
+  image_data nan_ref;
+  nan_ref.width = 16, nan_ref.height = 12;
+  nan_ref.pixels.assign(16 * 12 * 3, 0.5f);
+  nan_ref.pixels[3 * (2 * 16 + 5) + 1] = std::nanf("");
+  write_image(s.dir / "nan.pfm", nan_ref);
+  r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "out.exr") + " --reference " + (s.dir / "nan.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 3);
+  CHECK(r.output.find("nan.pfm: reference has a non-finite value at pixel (5, 2)") != std::string::npos);
+  CHECK(!exists(s.dir / "out.exr"));
+}
+
+TEST_CASE("a camera given in part takes the framing of a bare OBJ for the rest", "[cli]") {
+  // SPEC 3: every key but mesh has the bare OBJ's default. The bare OBJ's camera looks at the bounds' centre
+  // from +z: a scene file with only that target, or only that eye, renders the same image.
+  tiny_scene s;
+  auto bare = run_bayeslight("render " + (s.dir / "box.obj") + " --spp 1 --width 8 --height 6 --quiet -o " +
+                             (s.dir / "bare.pfm"));
+  REQUIRE(bare.status == 0);
+  // The box's bounds: x, z in [-1, 1], y in [0, 1]; centre (0, 0.5, 0).
+  write_text(s.dir / "target.json", "{\"mesh\": \"box.obj\", \"camera\": {\"target\": [0, 0.5, 0]}}");
+  auto t = run_bayeslight("render " + (s.dir / "target.json") + " --spp 1 --width 8 --height 6 --quiet -o " +
+                          (s.dir / "target.pfm"));
+  INFO(t.output);
+  REQUIRE(t.status == 0);
+  CHECK(read_image(s.dir / "target.pfm").pixels == read_image(s.dir / "bare.pfm").pixels);
+  // An eye alone looks at the centre: the same image as that eye with the centre as its target.
+  write_text(s.dir / "eye.json", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0.5, 1.5, 2.5]}}");
+  write_text(s.dir / "both.json",
+             "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0.5, 1.5, 2.5], \"target\": [0, 0.5, 0]}}");
+  for (const char* name : {"eye", "both"}) {
+    auto e = run_bayeslight("render " + (s.dir / (std::string(name) + ".json")) +
+                            " --spp 1 --width 8 --height 6 --quiet -o " + (s.dir / (std::string(name) + ".pfm")));
+    INFO(e.output);
+    REQUIRE(e.status == 0);
+  }
+  image_data eye = read_image(s.dir / "eye.pfm");
+  CHECK(eye.pixels == read_image(s.dir / "both.pfm").pixels);
+  CHECK(eye.pixels != read_image(s.dir / "bare.pfm").pixels);
 }
 
 TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
