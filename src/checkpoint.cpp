@@ -246,6 +246,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(scene.sun.angular_diameter_deg), h.value(scene.two_sided_emitters);
   h.value(p.width), h.value(p.height), h.value(p.max_depth), h.value(p.seed), h.value(int(p.sampler.kind));
   h.value(p.pass_weighting);
+  h.value(p.stratify);
   const region_params& r = p.sampler.regions;
   h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
   h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);

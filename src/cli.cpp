@@ -61,6 +61,7 @@ struct render_options {
   int frames = 1;
   double frame_decay = 0.5;
   double pass_weighting = 4;
+  bool independent = false;
   std::string checkpoint;
   double checkpoint_every = 30;
   std::string resume;
@@ -117,6 +118,7 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.frames = o.frames;
   p.frame_decay = o.frame_decay;
   p.pass_weighting = o.pass_weighting;
+  p.stratify = !o.independent;
   p.progress = !o.quiet && stderr_is_terminal();
   return p;
 }
@@ -280,6 +282,9 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "passes, taken before much is learned, weigh less; fixed in advance, so the image stays unbiased "
                 "(default 4; 0: all samples alike)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number);
+  r->add_flag("--independent-samples", o.independent,
+              "Independent random light choices, light points and BSDF directions at the first hit (default: "
+              "stratified over each pixel's samples, or over each pass's for the adaptive samplers)");
   // Regions, cuts and the ablation switches of the adaptive samplers.
   const char* grp = "Regions and light cuts (bound, bayes)";
   r->add_option("--grid", o.regions.grid, "Region cells along the shortest axis of the scene bounds (default 64)")

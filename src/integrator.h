@@ -35,6 +35,12 @@ struct render_inputs {
   camera_data camera;
   int max_depth = 5;
   uint64_t seed = 0;
+  // The first vertex's light and BSDF dimensions are stratified over sets of a pixel's samples (rng.h,
+  // stratify_first_vertex): samples from stratum_base on form one set, keyed by stratum_key (stratum_key_of). A
+  // sampler without learning has one set for the whole render; a learning one a set per pass, so that the samples
+  // of a pass depend on no earlier sample that its model learned from (which keeps the estimator unbiased).
+  bool stratify = true;
+  uint64_t stratum_base = 0, stratum_key = 0;
 };
 
 // Counters of one worker's share of a pass (summed in a fixed order afterwards).
@@ -127,6 +133,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     }
     vertex_randoms r = draw_vertex(key, uint32_t(depth));
     bool last = depth >= in.max_depth;
+    if (depth == 1 && in.stratify)
+      stratify_first_vertex(in.stratum_key, uint64_t(pixel), uint32_t(sample - in.stratum_base), last, r);
     typename Sampler::context& ctx = ctxs[depth & 1];
     shade_point spt{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth, last};
     tm.stop(prof_shading, t0);

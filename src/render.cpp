@@ -174,9 +174,13 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     progress.pass_spp = count;
     progress.rows_done = 0;
     auto t0 = clock_type::now();
+    // Stratified sets (integrator.h): one per pass while the sampler learns, else one for the whole render.
+    render_inputs pin = in;
+    pin.stratum_base = adapts(sampler) ? uint64_t(done) : 0;
+    pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
     auto run = [&](const auto& s) {
-      return params.profile ? run_pass<true>(in, s, done, done + count, pass_sum, rows, arena, progress)
-                            : run_pass<false>(in, s, done, done + count, pass_sum, rows, arena, progress);
+      return params.profile ? run_pass<true>(pin, s, done, done + count, pass_sum, rows, arena, progress)
+                            : run_pass<false>(pin, s, done, done + count, pass_sum, rows, arena, progress);
     };
     bool complete;
     // A bayes sampler that fell back runs its passes as the power sampler itself: the hot path has none of its code.
@@ -262,6 +266,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   in.camera = make_camera(scene.camera, params.width, params.height);
   in.max_depth = params.max_depth;
   in.seed = params.seed;
+  in.stratify = params.stratify;
   int frames = std::max(1, params.frames);
   auto t0 = clock_type::now();
   light_tree_data tree;

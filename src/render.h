@@ -38,6 +38,7 @@ struct render_params {
   // Adaptive samplers (bayes, donikian): the samples of a pass taken after n spp count pass_weight(n, this)
   // times in the image (0: all alike). Fixed in advance, so the weighted mean stays unbiased.
   double pass_weighting = 4;
+  bool stratify = true;       // stratified light and BSDF samples at the first vertex (integrator.h)
   std::vector<const image_data*> frame_references;  // per frame (overrides `reference` when not empty)
   // Called after every completed pass (last = false) and once when the render ends (last = true), with the state
   // of the completed passes: what a checkpoint saves.

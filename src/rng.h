@@ -2,7 +2,9 @@
 // Invariants: a (pixel, sample) pair owns one PCG32 key; each path vertex draws its own fixed-size block of
 // uniforms from the PCG32 stream numbered by the vertex, in the fixed order of the dimension table below.
 // So changing the light sampler (which uses only the light dimensions) leaves camera rays and BSDF samples
-// untouched, and no random number depends on thread identity or timing.
+// untouched, and no random number depends on thread identity or timing. The camera's jitter and, at the first
+// vertex, the light choice, light point and BSDF direction come instead from randomised Sobol' sets over a pixel's
+// samples (pixel_jitter, stratify_first_vertex): still functions of (seed, pixel, sample) alone.
 #pragma once
 
 #include <pcg_random.hpp>
@@ -69,18 +71,30 @@ inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex) {
 
 // Bits of i in reverse order: the base-2 radical inverse of i (van der Corput) in 0.32 fixed point.
 inline uint32_t reverse_bits(uint32_t i) {
-  i = (i << 16) | (i >> 16);
-  i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+  i = __builtin_bswap32(i);
   i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
   i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
   return ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
 }
-// The second dimension of the Sobol' sequence at index i in 0.32 fixed point (direction numbers of x + 1).
-inline uint32_t sobol_second(uint32_t i) {
+// The second dimension of the Sobol' sequence at index i in 0.32 fixed point (direction numbers of x + 1), bit by bit.
+constexpr uint32_t sobol_second_bits(uint32_t i) {
   uint32_t r = 0;
   for (uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
     if (i & 1) r ^= v;
   return r;
+}
+// The same, a byte at a time: the map is linear over GF(2), so it is the XOR of its values on the index's four bytes.
+struct sobol_second_table {
+  uint32_t t[4][256] = {};
+  constexpr sobol_second_table() {
+    for (int b = 0; b < 4; b++)
+      for (uint32_t v = 0; v < 256; v++) t[b][v] = sobol_second_bits(v << (8 * b));
+  }
+};
+inline constexpr sobol_second_table sobol_second_lut{};
+inline uint32_t sobol_second(uint32_t i) {
+  const auto& t = sobol_second_lut.t;
+  return t[0][i & 0xff] ^ t[1][(i >> 8) & 0xff] ^ t[2][(i >> 16) & 0xff] ^ t[3][i >> 24];
 }
 
 // Jitter inside pixel `pixel` of its sample `sample`: point `sample` of the two-dimensional Sobol' sequence (van der
@@ -94,6 +108,58 @@ inline void pixel_jitter(uint64_t seed, uint64_t pixel, uint64_t sample, float& 
   uint32_t i = uint32_t(sample);
   u = uint_to_unit(reverse_bits(i) ^ sx);
   v = uint_to_unit(sobol_second(i) ^ sy);
+}
+
+// A nested uniform scramble of x from its low bit up: bit k of the result is bit k of x flipped by a function of
+// `seed` and of the bits below k (additions carry upward only; x * c with c even reads only lower bits). So the
+// values with the same low bits (an aligned block of 2^k, read in reverse) map onto such a block.
+inline uint32_t scramble_low_first(uint32_t x, uint32_t seed) {
+  x += seed;
+  x ^= x * 0x9e3779b8u;
+  x += seed * 0x2545f491u;
+  x ^= x * 0xd1b54a32u;
+  x += seed ^ 0x68e31da4u;
+  x ^= x * 0x5851f42cu;
+  x ^= x * 0x14057b7eu;
+  return x;
+}
+
+// Sample `sample` of a pixel's randomised one-dimensional set with hash h: the van der Corput point of a shuffled
+// index (the sample's reversed bits under the nested scramble, so an aligned block of 2^k samples takes an aligned
+// block of 2^k indices: one point in each interval of length 2^-k), digitally shifted (XOR), so each sample is
+// uniform. Sets of different hashes are independent.
+inline uint32_t shuffled_vdc(uint32_t sample, uint64_t h) {
+  return scramble_low_first(reverse_bits(sample), uint32_t(h)) ^ uint32_t(h >> 32);
+}
+// The same for a two-dimensional set: the Sobol' point (van der Corput, Sobol's second dimension) of the shuffled
+// index, whose aligned blocks of 2^k form (0, k, 2)-nets (one point in each cell of every 2^a x 2^b grid with
+// a + b = k), each coordinate digitally shifted.
+inline void sobol_pair(uint32_t sample, uint64_t h, uint32_t& a, uint32_t& b) {
+  uint32_t r = scramble_low_first(reverse_bits(sample), uint32_t(h));  // the shuffled index, reversed
+  a = r ^ uint32_t(h >> 32);
+  b = sobol_second(reverse_bits(r)) ^ uint32_t(mix64(h));
+}
+
+// The key of the stratified sets that start at sample `base` of a render with seed `seed`.
+inline uint64_t stratum_key_of(uint64_t seed, uint64_t base) {
+  return mix64(mix64(seed ^ 0xbb67ae8584caa73bull) ^ (base * 0x9e3779b97f4a7c15ull));
+}
+// Stratifies over a set of a pixel's samples (`index`: the sample's place in the set, `key`: the set's) the first
+// vertex's light choice (1D), point on the light (2D) and, unless `last`, BSDF direction (2D), replacing those
+// dimensions of r. Each of the three has its own shuffle and shifts, from the pixel's hash; each sample stays
+// uniform, so any estimator stays unbiased, and 2^k consecutive samples from a multiple of 2^k are stratified.
+// The inner choice inside a cluster, the lobe and roulette keep their independent draws.
+inline void stratify_first_vertex(uint64_t key, uint64_t pixel, uint32_t index, bool last, vertex_randoms& r) {
+  uint64_t k = mix64(key ^ pixel);
+  r.raw[dim_light_select] = shuffled_vdc(index, mix64(k + 1));
+  sobol_pair(index, mix64(k + 2), r.raw[dim_light_u], r.raw[dim_light_v]);
+  r.u[dim_light_select] = uint_to_unit(r.raw[dim_light_select]);
+  r.u[dim_light_u] = uint_to_unit(r.raw[dim_light_u]);
+  r.u[dim_light_v] = uint_to_unit(r.raw[dim_light_v]);
+  if (last) return;
+  sobol_pair(index, mix64(k + 3), r.raw[dim_bsdf_u], r.raw[dim_bsdf_v]);
+  r.u[dim_bsdf_u] = uint_to_unit(r.raw[dim_bsdf_u]);
+  r.u[dim_bsdf_v] = uint_to_unit(r.raw[dim_bsdf_v]);
 }
 
 }  // namespace bl

@@ -98,6 +98,82 @@ TEST_CASE("pixel jitter is uniform per sample and stratified over a pixel's samp
   CHECK((u0 != u3 || v0 != v3));
 }
 
+// The first vertex's randoms of sample `index` of a stratified set with key `key`, pixel `px`.
+static vertex_randoms first_vertex(uint64_t key, uint64_t px, uint32_t index, bool last = false) {
+  vertex_randoms r = draw_vertex(sample_key(9, px, index), 1);
+  stratify_first_vertex(key, px, index, last, r);
+  return r;
+}
+
+TEST_CASE("the first vertex's light and BSDF samples are stratified over a set, uniform and independent", "[rng]") {
+  const uint64_t key = stratum_key_of(5, 0);
+  // Stratified: any aligned block of 16 samples puts one light choice in each 1/16 of [0, 1), and one light point
+  // and one BSDF direction in each cell of every 2^a x 2^(4-a) grid.
+  for (uint64_t px = 0; px < 50; px++)
+    for (uint32_t block : {0u, 3u}) {
+      std::set<int> select;
+      std::set<int> light[5], bsdf[5];
+      for (uint32_t i = 16 * block; i < 16 * block + 16; i++) {
+        vertex_randoms r = first_vertex(key, px, i);
+        select.insert(int(r.u53(dim_light_select, dim_light_select_lo) * 16));
+        for (int a = 0; a <= 4; a++) {
+          light[a].insert(int(r.u[dim_light_u] * float(1 << a)) * 16 + int(r.u[dim_light_v] * float(1 << (4 - a))));
+          bsdf[a].insert(int(r.u[dim_bsdf_u] * float(1 << a)) * 16 + int(r.u[dim_bsdf_v] * float(1 << (4 - a))));
+        }
+      }
+      CHECK(select.size() == 16);
+      for (int a = 0; a <= 4; a++) {
+        CHECK(light[a].size() == 16);
+        CHECK(bsdf[a].size() == 16);
+      }
+    }
+  // Uniform per sample: sample 0 and sample 37 of 40000 pixels (independent shuffles and shifts), chi-square over
+  // 100 cells (99 degrees of freedom; p > 1e-4 fails one run in 10^4 per check).
+  for (uint32_t i : {0u, 37u}) {
+    std::vector<double> sel(100, 0.0), light(100, 0.0), bsdf(100, 0.0), expected(100, 400.0);
+    for (uint64_t px = 0; px < 40000; px++) {
+      vertex_randoms r = first_vertex(key, px, i);
+      sel[size_t(r.u53(dim_light_select, dim_light_select_lo) * 100)] += 1;
+      light[size_t(int(r.u[dim_light_u] * 10) * 10 + int(r.u[dim_light_v] * 10))] += 1;
+      bsdf[size_t(int(r.u[dim_bsdf_u] * 10) * 10 + int(r.u[dim_bsdf_v] * 10))] += 1;
+    }
+    CHECK(bl::test::chi2_pvalue(sel, expected) > 1e-4);
+    CHECK(bl::test::chi2_pvalue(light, expected) > 1e-4);
+    CHECK(bl::test::chi2_pvalue(bsdf, expected) > 1e-4);
+  }
+  // Independent between dimensions: over the 256 samples of each of 100 pixels, the pairs (choice, light u),
+  // (light u, BSDF u), (light v, BSDF v) and (jitter u, light u) fill a 10 x 10 grid evenly (sets that shared one
+  // shuffle would tie one coordinate to the other through their shifts and leave most cells empty).
+  std::vector<double> h[4];
+  for (auto& x : h) x.assign(100, 0.0);
+  std::vector<double> expected(100, 256.0);
+  auto cell = [](float a, float b) { return size_t(int(a * 10) * 10 + int(b * 10)); };
+  for (uint64_t px = 0; px < 100; px++)
+    for (uint32_t i = 0; i < 256; i++) {
+      vertex_randoms r = first_vertex(key, px, i);
+      float ju, jv;
+      pixel_jitter(5, px, i, ju, jv);
+      h[0][cell(r.u[dim_light_select], r.u[dim_light_u])] += 1;
+      h[1][cell(r.u[dim_light_u], r.u[dim_bsdf_u])] += 1;
+      h[2][cell(r.u[dim_light_v], r.u[dim_bsdf_v])] += 1;
+      h[3][cell(ju, r.u[dim_light_u])] += 1;
+    }
+  for (int k = 0; k < 4; k++) {
+    INFO("pair " << k);
+    CHECK(bl::test::chi2_pvalue(h[k], expected) > 1e-4);
+  }
+  // The last vertex keeps its BSDF draws; the other dimensions are the independent draws of draw_vertex.
+  vertex_randoms plain = draw_vertex(sample_key(9, 7, 3), 1);
+  vertex_randoms last = first_vertex(key, 7, 3, true);
+  for (int d : {int(dim_light_inner), int(dim_bsdf_lobe), int(dim_roulette), int(dim_light_select_lo),
+                int(dim_light_inner_lo), int(dim_bsdf_u), int(dim_bsdf_v)})
+    CHECK(last.raw[d] == plain.raw[d]);
+  // Sets of other keys (another pass, another seed) are other sets.
+  CHECK(first_vertex(key, 7, 3).raw[dim_light_u] == first_vertex(key, 7, 3).raw[dim_light_u]);
+  CHECK(first_vertex(stratum_key_of(5, 8), 7, 3).raw[dim_light_u] != first_vertex(key, 7, 3).raw[dim_light_u]);
+  CHECK(first_vertex(stratum_key_of(6, 0), 7, 3).raw[dim_light_u] != first_vertex(key, 7, 3).raw[dim_light_u]);
+}
+
 TEST_CASE("make_frame is orthonormal for any unit normal", "[math]") {
   for (int i = 0; i < 1000; i++) {
     auto r = draw_vertex(sample_key(1, i, 0), 0);

@@ -172,6 +172,21 @@ struct mesh_builder {
     add_quad(p[0], p[1], p[5], p[4], material);  // -y
     add_quad(p[2], p[6], p[7], p[3], material);  // +y
   }
+  // Sphere of `rings` bands of latitude and 2 * rings sectors of longitude (quads; triangles at the poles).
+  void add_sphere(vec3f centre, float radius, int rings, int material) {
+    auto at = [&](int i, int j) {
+      double theta = M_PI * i / rings, phi = M_PI * j / rings;
+      return centre + vec3f{float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
+                            float(std::sin(theta) * std::sin(phi))} * radius;
+    };
+    for (int i = 0; i < rings; i++)
+      for (int j = 0; j < 2 * rings; j++) {
+        vec3f a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+        if (i > 0 && i + 1 < rings) add_quad(a, b, c, d, material);
+        else if (i == 0) add_triangle(a, b, c, material);
+        else add_triangle(a, b, d, material);
+      }
+  }
 };
 
 // A floor beside a closed box that holds a bright lamp (Ke 200), lit only by a dim lamp (Ke 1) outside the box:

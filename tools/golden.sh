@@ -32,4 +32,12 @@ file="cornell_path_bayes_fallback.pfm"
 args="data/cornell/path.json --sampler bayes --width 40 --height 30 --spp 512 --threads 2 --quiet"
 "$bin" render $args -o "$out/$file"
 echo "$file $args" >>"$manifest"
+# Independent samples at the first vertex (--independent-samples; the default stratifies them): the estimator of
+# earlier releases, a learning and a fixed sampler, path traced.
+for s in bound bayes; do
+  file="plant_room_path_${s}_independent.pfm"
+  args="data/plant_room/path.json --sampler $s --width 40 --height 30 --spp 4 --threads 2 --quiet --independent-samples"
+  "$bin" render $args -o "$out/$file"
+  echo "$file $args" >>"$manifest"
+done
 echo "wrote $(ls "$out"/*.pfm | wc -l) golden images and $manifest"
