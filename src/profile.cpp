@@ -52,16 +52,9 @@ ray_set make_shadow_rays(const scene_data& scene, const bvh_data& bvh, const lig
         int light = std::min(int(v.u[0] * float(lights.count)), lights.count - 1);
         light_sample ls = sample_light_point(lights, scene, light, sp.p, v.u[2], v.u[3]);
         if (!(ls.pdf > 0)) continue;
-        vec3f o = offset_ray_origin(scene, sp.p, sp.ng, ls.wi);
-        if (ls.dist == inf_f) {
-          rays.org.push_back(o), rays.dir.push_back(ls.wi), rays.tmax.push_back(inf_f);
-          continue;
-        }
-        vec3f t = offset_ray_origin(scene, ls.p, ls.n, -ls.wi);
-        vec3f dd = t - o;
-        float len = length(dd);
-        if (!(len > 0)) continue;
-        rays.org.push_back(o), rays.dir.push_back(dd / len), rays.tmax.push_back(len);
+        shadow_ray r = shadow_ray_of(scene, sp, ls);
+        if (!(r.tmax > 0)) continue;
+        rays.org.push_back(r.org), rays.dir.push_back(r.dir), rays.tmax.push_back(r.tmax);
       }
   return rays;
 }

@@ -52,10 +52,19 @@ surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2,
 inline float ray_epsilon(const scene_data& scene, vec3f p) {
   return 2e-5f * std::max(max_abs_component(p), 0.05f * scene.scale);
 }
-// p moved off its surface along the normal n toward the side of direction d.
-inline vec3f offset_ray_origin(const scene_data& scene, vec3f p, vec3f n, vec3f d) {
-  float eps = ray_epsilon(scene, p);
+// p moved off its surface along the normal n toward the side of direction d, by eps (default ray_epsilon).
+inline vec3f offset_along(vec3f p, vec3f n, vec3f d, float eps) {
   return dot(n, d) >= 0 ? p + n * eps : p - n * eps;
+}
+inline vec3f offset_ray_origin(const scene_data& scene, vec3f p, vec3f n, vec3f d) {
+  return offset_along(p, n, d, ray_epsilon(scene, p));
+}
+// The offset of one end p of a segment to q: ray_epsilon, but at most a quarter of q's height above p's surface
+// (a lamp closer to a surface than the offset would otherwise have the segment start beyond it, or end behind the
+// surface), and at least 1/20 of ray_epsilon (about 16 float ulps of p: what the hit point's rounding needs).
+inline float segment_epsilon(const scene_data& scene, vec3f p, vec3f n, vec3f q) {
+  float eps = ray_epsilon(scene, p);
+  return std::max(std::min(eps, 0.25f * std::fabs(dot(n, q - p))), 0.05f * eps);
 }
 
 }  // namespace bl

@@ -81,6 +81,32 @@ TEST_CASE("a point under a large emitting square receives the closed form irradi
     }
 }
 
+TEST_CASE("a lamp just above a floor far from the origin gives the closed form irradiance", "[analytic]") {
+  // The square lamp of the test above at 1/50 of its size, 0.01 above the floor, everything moved to (1000, 1000,
+  // 1000): the gap is half the default ray offset there (2e-5 x 1000), which a shadow ray must not step over.
+  const vec3f c = {1000, 1000, 1000};
+  const float a = 0.02f, h = 0.01f, le = 2.0f, rho = 0.5f;
+  for (sampler_kind kind : {sampler_kind::uniform, sampler_kind::bound, sampler_kind::bayes}) {
+    mesh_builder b;
+    int floor = b.add_material({rho, rho, rho});
+    int lamp = b.add_material({0, 0, 0}, {le, le, le});
+    b.add_quad(c + vec3f{-20, 0, -20}, c + vec3f{-20, 0, 20}, c + vec3f{20, 0, 20}, c + vec3f{20, 0, -20}, floor);
+    b.add_quad(c + vec3f{-a, h, -a}, c + vec3f{a, h, -a}, c + vec3f{a, h, a}, c + vec3f{-a, h, a}, lamp);
+    // The closed form for the geometry as stored (float coordinates near 1000 are 6e-5 apart).
+    double hs = double(c.y + h) - double(c.y), as = double(c.x + a) - double(c.x);
+    double A = as / hs, s = A / std::sqrt(1 + A * A);
+    double exact = rho / M_PI * 4 * le * s * std::atan(s);
+    camera_params cam;
+    cam.automatic = false;
+    cam.eye = c + vec3f{0, 0.005f, 0};
+    cam.target = c;
+    cam.up = {0, 0, -1};
+    cam.fov_y_deg = 0.5f;
+    INFO("sampler " << sampler_name(kind));
+    check_estimate(render_pixels(b.mesh, cam, {}, false, kind, 1, 1024), exact);
+  }
+}
+
 TEST_CASE("a furnace sphere of emitting grey walls sums its bounces", "[analytic]") {
   // Closed surface, every triangle emits Le (two-sided) with albedo rho: radiance Le * sum_{k=0..D} rho^k.
   // A tessellated sphere, not a box: in a box, the NEE of a vertex near an edge samples the adjacent wall with an
