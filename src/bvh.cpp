@@ -24,15 +24,13 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     if (args->valid[i] != -1) continue;
     unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     int material = scene->mesh.tri_materials[prim];
-    int tex = scene->mesh.materials[material].alpha_texture;
-    if (tex == invalid_id) continue;
+    if (scene->mesh.materials[material].alpha_texture == invalid_id) continue;
     vec3f org = {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
                  RTCRayN_org_z(args->ray, args->N, i)};
     vec3f dir = {RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
                  RTCRayN_dir_z(args->ray, args->N, i)};
     hit_info h = intersect_triangle(*scene, int(prim), org, dir);
-    surface_point sp = eval_surface(*scene, int(prim), h.b1, h.b2, dir);
-    if (eval_texture_alpha(scene->mesh.textures[tex], sp.uv) < 0.5f) args->valid[i] = 0;
+    if (alpha_hole(*scene, int(prim), h.b1, h.b2)) args->valid[i] = 0;
   }
 }
 

@@ -58,6 +58,8 @@ light_sample sample_light_point(const light_data& l, const scene_data& scene, in
   vec2f b = sample_triangle(u, v);
   s.p = scene.tri_p0[t] + scene.tri_e1[t] * b.x + scene.tri_e2[t] * b.y;
   s.n = scene.tri_ng[t];
+  // A hole of the emitter's own cut-out emits nothing (rays pass through it; pdf 0: no contribution).
+  if (scene.has_alpha && alpha_hole(scene, t, b.x, b.y)) return s;
   vec3f d = s.p - x;
   float dist2 = length_sq(d);
   if (!(dist2 > 0)) return s;

@@ -2,6 +2,7 @@
 #include "scene.h"
 
 #include "errors.h"
+#include "texture.h"
 
 namespace bl {
 
@@ -76,12 +77,22 @@ surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2,
     if (dot(ns, sp.ng) < 0) ns = -ns;
     if (length_sq(ns) > 0) sp.ns = ns;
   }
-  const int* ct = &m.tri_texcoords[3 * tri];
-  if (ct[0] != invalid_id && ct[1] != invalid_id && ct[2] != invalid_id) {
-    vec2f t0 = m.texcoords[ct[0]], t1 = m.texcoords[ct[1]], t2 = m.texcoords[ct[2]];
-    sp.uv = {t0.x * b0 + t1.x * b1 + t2.x * b2, t0.y * b0 + t1.y * b1 + t2.y * b2};
-  }
+  sp.uv = surface_uv(scene, tri, b1, b2);
   return sp;
+}
+
+vec2f surface_uv(const scene_data& scene, int tri, float b1, float b2) {
+  const mesh_data& m = scene.mesh;
+  const int* ct = &m.tri_texcoords[3 * tri];
+  if (ct[0] == invalid_id || ct[1] == invalid_id || ct[2] == invalid_id) return {0, 0};
+  float b0 = 1.0f - b1 - b2;
+  vec2f t0 = m.texcoords[ct[0]], t1 = m.texcoords[ct[1]], t2 = m.texcoords[ct[2]];
+  return {t0.x * b0 + t1.x * b1 + t2.x * b2, t0.y * b0 + t1.y * b1 + t2.y * b2};
+}
+
+bool alpha_hole(const scene_data& scene, int tri, float b1, float b2) {
+  int tex = scene.mesh.materials[size_t(scene.mesh.tri_materials[size_t(tri)])].alpha_texture;
+  return tex != invalid_id && eval_texture_alpha(scene.mesh.textures[size_t(tex)], surface_uv(scene, tri, b1, b2)) < 0.5f;
 }
 
 }  // namespace bl

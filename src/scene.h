@@ -47,6 +47,10 @@ struct surface_point {
 
 // Barycentric point (b1, b2) of triangle t seen by a ray with direction `dir`.
 surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f dir);
+// Texture coordinates of triangle tri at barycentrics (b1, b2) ((0, 0) without vt).
+vec2f surface_uv(const scene_data& scene, int tri, float b1, float b2);
+// Whether that point is a hole of its material's map_d cut-out (alpha < 0.5): no hit, no shadow, no emission.
+bool alpha_hole(const scene_data& scene, int tri, float b1, float b2);
 
 // Distance to offset a ray origin at p off its surface: scale-aware (relative to the scene's magnitude).
 inline float ray_epsilon(const scene_data& scene, vec3f p) {

@@ -7,6 +7,7 @@
 #include "render.h"
 #include "scene.h"
 #include "test_util.h"
+#include "texture.h"
 
 #include <catch2/catch.hpp>
 
@@ -76,6 +77,36 @@ TEST_CASE("a point under a large emitting square receives the closed form irradi
       b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, dim);       // faces up: never lights the floor
       double A = a / h, s = A / std::sqrt(1 + A * A);
       double exact = rho / M_PI * 4 * le * s * std::atan(s);
+      INFO("sampler " << sampler_name(kind) << " depth " << depth);
+      check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, depth, 1024), exact);
+    }
+}
+
+TEST_CASE("the holes of an emitter's own map_d emit nothing", "[analytic]") {
+  // The square lamp above with a two-texel cut-out: its half x < 0 opaque, its half x > 0 a hole. The point under
+  // the centre, on the line between the halves, receives half the whole square's irradiance by symmetry.
+  const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
+  for (sampler_kind kind : kinds)
+    for (int depth : {1, 2}) {
+      mesh_builder b;
+      int floor = b.add_material({rho, rho, rho});
+      int lamp = b.add_material({0, 0, 0}, {le, le, le});
+      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
+      size_t first = b.mesh.tri_positions.size();
+      b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);
+      for (size_t k = first; k < b.mesh.tri_positions.size(); k++) {
+        vec3f p = b.mesh.positions[size_t(b.mesh.tri_positions[k])];
+        b.mesh.tri_texcoords[k] = int(b.mesh.texcoords.size());
+        b.mesh.texcoords.push_back({(p.x + a) / (2 * a), (p.z + a) / (2 * a)});
+      }
+      texture_data mask;
+      mask.width = 2, mask.height = 1;
+      mask.rgb.assign(2, vec3f{1, 1, 1});
+      mask.alpha = {1.0f, 0.0f};
+      b.mesh.textures.push_back(mask);
+      b.mesh.materials[size_t(lamp)].alpha_texture = 0;
+      double A = a / h, s = A / std::sqrt(1 + A * A);
+      double exact = 0.5 * rho / M_PI * 4 * le * s * std::atan(s);
       INFO("sampler " << sampler_name(kind) << " depth " << depth);
       check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, depth, 1024), exact);
     }
