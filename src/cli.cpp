@@ -97,6 +97,31 @@ void check_output_path(const std::string& path) {
   if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write " + path + ": directory " + dir.string() + " is not writable");
 }
 
+// The same file, whether or not it exists yet (symbolic links and "." / ".." resolved).
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ea, eb;
+  fs::path pa = fs::weakly_canonical(fs::absolute(a), ea), pb = fs::weakly_canonical(fs::absolute(b), eb);
+  if (ea || eb) return fs::path(a).lexically_normal() == fs::path(b).lexically_normal();
+  return pa == pb;
+}
+
+// Refuses a render whose outputs would overwrite one of its inputs or one another (exit 2, before any work).
+// Files are (path, role) pairs; the one overlap allowed is a checkpoint resumed from and written again.
+constexpr const char* resumed_role = "checkpoint resumed from";
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs,
+                            const std::vector<std::pair<std::string, std::string>>& inputs) {
+  for (size_t i = 0; i < outputs.size(); i++) {
+    for (const auto& in : inputs)
+      if (!(in.second == resumed_role && outputs[i].second == "checkpoint") && same_file(outputs[i].first, in.first))
+        throw usage_error(outputs[i].second + " " + outputs[i].first + " would overwrite the " + in.second + " " +
+                          in.first);
+    for (size_t j = 0; j < i; j++)
+      if (same_file(outputs[i].first, outputs[j].first))
+        throw usage_error(outputs[i].second + " " + outputs[i].first + " is also the " + outputs[j].second + " " +
+                          outputs[j].first);
+  }
+}
+
 // The validated render parameters of a scene and the command line.
 render_params resolve_params(const render_options& o, const scene_desc& desc, sampler_kind kind) {
   render_params p;
@@ -179,6 +204,18 @@ int run_render(const render_options& o) {
   auto t_load = std::chrono::steady_clock::now();
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
   report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
+  {
+    std::vector<std::pair<std::string, std::string>> outs, ins = {{o.scene, "scene file"}};
+    for (int f = 0; f < params.frames; f++) {
+      for (const std::string& out : outputs) outs.push_back({frame_path(out, f), "output"});
+      if (!o.log.empty()) outs.push_back({frame_path(o.log, f), "log"});
+      if (!o.reference.empty()) ins.push_back({frame_path(o.reference, f), "reference"});
+    }
+    if (!o.checkpoint.empty()) outs.push_back({o.checkpoint, "checkpoint"});
+    for (const std::string& src : scene.mesh.source_files) ins.push_back({src, "scene input"});
+    if (!o.resume.empty()) ins.push_back({o.resume, resumed_role});
+    check_distinct_outputs(outs, ins);
+  }
   auto t_bvh = std::chrono::steady_clock::now();
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);

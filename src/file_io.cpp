@@ -45,12 +45,27 @@ static int close_checked(int fd) {
   return errno;
 }
 
+void require_regular_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw input_error(path, reason(errno));
+  if (S_ISDIR(st.st_mode)) throw input_error(path, "is a directory");
+  if (!S_ISREG(st.st_mode)) throw input_error(path, "not a regular file");
+}
+
 std::string read_file(const std::string& path) {
-  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; only regular files are read (a FIFO or a device such
+  // as /dev/urandom would block or never end).
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) throw input_error(path, reason(errno));
   std::string bytes;
   struct stat st {};
-  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) bytes.reserve(size_t(st.st_size));
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    bool dir = S_ISDIR(st.st_mode);
+    ::close(fd);
+    throw input_error(path, dir ? "is a directory" : "not a regular file");
+  }
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  if (st.st_size > 0) bytes.reserve(size_t(st.st_size));
   char buf[1 << 16];
   for (;;) {
     ssize_t k = ::read(fd, buf, sizeof buf);

@@ -8,6 +8,8 @@
 
 namespace bl {
 
+// Throws input_error naming path unless it is an existing regular file (not a FIFO, device or directory).
+void require_regular_file(const std::string& path);
 // The whole content of a file; throws input_error(path, reason) when it cannot be opened or read.
 std::string read_file(const std::string& path);
 

@@ -9,6 +9,7 @@
 #include "errors.h"
 #include "obj_validate.h"
 
+#include <algorithm>
 #include <tiny_obj_loader.h>
 
 #include <climits>
@@ -316,6 +317,11 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
       mesh.materials.back().name = "default";
       break;
     }
+  mesh.source_files.push_back(path);
+  for (const auto& m : clean.materials)
+    if (std::find(mesh.source_files.begin(), mesh.source_files.end(), m.mtl_path) == mesh.source_files.end())
+      mesh.source_files.push_back(m.mtl_path);
+  for (const texture_data& t : mesh.textures) mesh.source_files.push_back(t.path);
   return mesh;
 }
 

@@ -39,6 +39,7 @@ struct mesh_data {
   std::vector<material_data> materials;
   std::vector<texture_data> textures;
   int dropped_degenerate = 0;     // zero-area or non-finite triangles removed on load
+  std::vector<std::string> source_files;  // the OBJ, the MTL files of its used materials, their textures
 };
 
 inline int triangle_count(const mesh_data& m) { return int(m.tri_materials.size()); }

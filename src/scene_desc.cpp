@@ -2,6 +2,7 @@
 #include "scene_desc.h"
 
 #include "errors.h"
+#include "file_io.h"
 
 #include <nlohmann/json.hpp>
 
@@ -142,15 +143,12 @@ scene_desc load_scene_desc(const std::string& path) {
     throw input_error(path, "unknown scene type \"" + ext + "\" (expected a .json scene file or a .obj mesh)");
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw input_error(path, "is a directory, not a scene file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw input_error(path, std::string("cannot open: ") + std::strerror(errno));
+  require_regular_file(path);  // a FIFO would block the read, a device might never end
   if (ext == ".obj") {
     desc.mesh_path = path;
     return desc;
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  desc_context ctx{path, ss.str()};
+  desc_context ctx{path, read_file(path)};
 
   json root;
   // Keys given twice in one object: nlohmann keeps the last silently, which would drop the first's settings.

@@ -5,6 +5,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+
 using namespace bl;
 using namespace bl::test;
 
@@ -222,6 +224,71 @@ TEST_CASE("a camera given in part takes the framing of a bare OBJ for the rest",
   image_data eye = read_image(s.dir / "eye.pfm");
   CHECK(eye.pixels == read_image(s.dir / "both.pfm").pixels);
   CHECK(eye.pixels != read_image(s.dir / "bare.pfm").pixels);
+}
+
+TEST_CASE("outputs that would overwrite an input or each other are refused before rendering", "[cli]") {
+  tiny_scene s;
+  write_text(s.dir / "tex.mtl", "newmtl floor\nKd 0.5 0.5 0.5\nmap_Kd floor.png\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
+  image_data grey;  // the texture: a 1x1 PNG
+  grey.width = grey.height = 1;
+  grey.pixels = {0.5f, 0.5f, 0.5f};
+  write_image(s.dir / "floor.png", grey);
+  write_text(s.dir / "tex.obj", "mtllib tex.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                "v -0.2 1 -0.2\nv 0.2 1 -0.2\nv 0.2 1 0.2\nv -0.2 1 0.2\n"
+                                "usemtl floor\nf 1/1 4/4 3/3 2/2\nusemtl lamp\nf 5 6 7 8\n");
+  write_text(s.dir / "tex.json", "{\"mesh\": \"tex.obj\", \"image\": {\"width\": 8, \"height\": 6}, \"render\": {\"spp\": 1}}");
+  REQUIRE(run_bayeslight("render " + (s.dir / "tex.json") + " --quiet -o " + (s.dir / "ref.pfm")).status == 0);
+  const std::string scene_json = read_text(s.dir / "tex.json"), obj = read_text(s.dir / "tex.obj"),
+                    mtl = read_text(s.dir / "tex.mtl"), tex = read_text(s.dir / "floor.png"), ref = read_text(s.dir / "ref.pfm");
+  struct bad_case {
+    std::string args, expect;
+  };
+  std::string sc = s.dir / "tex.json";
+  std::vector<bad_case> cases = {
+      {sc + " --checkpoint " + sc, "would overwrite the scene file"},
+      {sc + " --log " + (s.dir / "tex.obj"), "would overwrite the scene input"},
+      {sc + " --checkpoint " + (s.dir / "tex.mtl"), "would overwrite the scene input"},
+      {sc + " -o " + (s.dir / "floor.png"), "would overwrite the scene input"},
+      {sc + " --reference " + (s.dir / "ref.pfm") + " -o " + (s.dir / "sub/../ref.pfm"), "would overwrite the reference"},
+      {sc + " -o " + (s.dir / "a.pfm") + " --log " + (s.dir / "./a.pfm"), "is also the output"},
+  };
+  std::filesystem::create_directory(s.dir / "sub");
+  for (const auto& c : cases) {
+    auto r = run_bayeslight("render " + c.args + " --quiet");
+    INFO(c.args << "\n" << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(c.expect) != std::string::npos);
+  }
+  CHECK(read_text(s.dir / "tex.json") == scene_json);
+  CHECK(read_text(s.dir / "tex.obj") == obj);
+  CHECK(read_text(s.dir / "tex.mtl") == mtl);
+  CHECK(read_text(s.dir / "floor.png") == tex);
+  CHECK(read_text(s.dir / "ref.pfm") == ref);
+  CHECK(!exists(s.dir / "a.pfm"));
+  // The one overlap allowed: a checkpoint resumed from and written again.
+  std::string ck = s.dir / "ck.bin";
+  REQUIRE(run_bayeslight("render " + sc + " --quiet --checkpoint " + ck + " -o " + (s.dir / "b.pfm")).status == 0);
+  auto again = run_bayeslight("render " + sc + " --quiet --spp 2 --resume " + ck + " --checkpoint " + ck + " -o " +
+                              (s.dir / "c.pfm"));
+  INFO(again.output);
+  CHECK(again.status == 0);
+}
+
+TEST_CASE("inputs that are not regular files are refused, never read", "[cli]") {
+  // A FIFO would block the read forever, a device such as /dev/urandom never ends.
+  tiny_scene s;
+  REQUIRE(::mkfifo((s.dir / "fifo.json").c_str(), 0600) == 0);
+  REQUIRE(::mkfifo((s.dir / "fifo.pfm").c_str(), 0600) == 0);
+  std::filesystem::create_symlink("/dev/zero", s.dir / "zero.json");
+  for (const std::string& args : {"render " + (s.dir / "fifo.json"), "render " + (s.dir / "zero.json"),
+                                  "render " + s.json + " --reference " + (s.dir / "fifo.pfm"),
+                                  "render " + s.json + " --resume " + (s.dir / "fifo.pfm"),
+                                  "diff " + (s.dir / "fifo.pfm") + " " + (s.dir / "fifo.pfm")}) {
+    auto r = run_bayeslight(args + (args.rfind("diff", 0) == 0 ? "" : " --quiet -o " + (s.dir / "o.pfm")));
+    INFO(args << "\n" << r.output);
+    CHECK(r.status == 3);
+    CHECK(r.output.find("not a regular file") != std::string::npos);
+  }
 }
 
 TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
