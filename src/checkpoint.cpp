@@ -15,9 +15,9 @@ namespace bl {
 namespace {
 
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
-constexpr uint32_t version = 7;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
+constexpr uint32_t version = 8;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
                                  // 5: mean hierarchy (k_folded); 6: bayes fallback check; 7: no point-prior
-                                 // weights in region-prior mode
+                                 // weights in region-prior mode; 8: the stratified set's first sample
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -267,7 +267,7 @@ std::string encode_checkpoint(uint64_t fingerprint, const render_result& result,
   w.value(version);
   w.value(fingerprint);
   w.value(uint32_t(sampler.index()));
-  w.value(result.width), w.value(result.height), w.value(result.passes), w.value(result.spp);
+  w.value(result.width), w.value(result.height), w.value(result.passes), w.value(result.spp), w.value(result.stratum_base);
   w.value(result.seconds);
   w.value(result.stats);
   w.value(uint64_t(result.log.size()));
@@ -303,6 +303,7 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
   if (w != result.width || hgt != result.height) r.fail("image size");
   result.passes = r.value<int>();
   result.spp = r.value<int>();
+  result.stratum_base = r.value<int>();
   result.seconds = r.value<double>();
   result.stats = r.value<path_stats>();
   uint64_t n = r.value<uint64_t>();
@@ -317,7 +318,7 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
   }
   result.film = r.column<double>(size_t(w) * size_t(hgt) * 3);
   result.film_weight = r.value<double>();
-  if (result.passes < 0 || result.spp < 0 || !(result.film_weight >= 0) || (result.spp > 0) != (result.film_weight > 0))
+  if (result.passes < 0 || result.spp < 0 || result.stratum_base < 0 || result.stratum_base > result.spp || !(result.film_weight >= 0) || (result.spp > 0) != (result.film_weight > 0))
     r.fail("pass state");
   read_sampler(r, sampler);
   if (auto* b = std::get_if<bayes_sampler>(&sampler); b && !b->px_var.empty() && b->px_var.size() != result.film.size() / 3)

@@ -154,7 +154,8 @@ bool is_frame_pattern(const std::string& p) {
   if (at == std::string::npos) return false;
   size_t k = at + 1;
   while (k < p.size() && (std::isdigit(static_cast<unsigned char>(p[k])) != 0)) k++;
-  return k < p.size() && p[k] == 'd' && p.find('%', k) == std::string::npos;
+  // A field width of at most two digits (%04d): a wider one would make names longer than a path may be.
+  return k < p.size() && k - at - 1 <= 2 && p[k] == 'd' && p.find('%', k) == std::string::npos;
 }
 // The path of frame `frame` of a frame pattern (the path itself when it is not a pattern).
 std::string frame_path(const std::string& pattern, int frame) {
@@ -231,7 +232,13 @@ int run_render(const render_options& o) {
 
   uint64_t fingerprint = render_fingerprint(scene, params);
   if (!o.resume.empty())
-    params.restore = [&](render_result& r, light_sampler& s) { decode_checkpoint(resume_bytes, o.resume, fingerprint, r, s); };
+    params.restore = [&](render_result& r, light_sampler& s) {
+      decode_checkpoint(resume_bytes, o.resume, fingerprint, r, s);
+      // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
+      if (params.time_budget <= 0 && r.spp > params.spp)
+        throw usage_error("--spp " + std::to_string(params.spp) + " is below the " + std::to_string(r.spp) +
+                          " spp already in " + o.resume);
+    };
   auto last_write = std::chrono::steady_clock::now();
   params.on_pass = [&](const render_result& r, const light_sampler& s, bool last) {
     if (!last && o.stop_after_passes > 0 && r.passes == o.stop_after_passes) std::raise(SIGINT);

@@ -126,6 +126,14 @@ bool adapts(const Sampler& s) {
   else return std::is_same_v<Sampler, donikian_sampler>;
 }
 
+// Whether the sampler's model would change if it learned from the pass just rendered (bayes: unless frozen or
+// fallen back to power sampling).
+template <class Sampler>
+bool model_moves(const Sampler& s) {
+  if constexpr (std::is_same_v<Sampler, bayes_sampler>) return !s.frozen && !s.fallback;
+  else return std::is_same_v<Sampler, donikian_sampler>;
+}
+
 // The pass loop for one sampler type; continues from the passes already in `result` (a resumed render).
 // after_pass is called after every completed pass.
 template <class Sampler>
@@ -174,9 +182,10 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     progress.pass_spp = count;
     progress.rows_done = 0;
     auto t0 = clock_type::now();
-    // Stratified sets (integrator.h): one per pass while the sampler learns, else one for the whole render.
+    // Stratified sets (integrator.h): a set starts with the render and after every change of the sampler's model,
+    // so no sample of a set depends on samples its model learned from; a model that stays keeps its set.
     render_inputs pin = in;
-    pin.stratum_base = adapts(sampler) ? uint64_t(done) : 0;
+    pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
     auto run = [&](const auto& s) {
       return params.profile ? run_pass<true>(pin, s, done, done + count, pass_sum, rows, arena, progress)
@@ -198,10 +207,19 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     for (const cycle_timers& t : rows.timers)
       for (int c = 0; c < prof_count; c++) result.profile_cycles[c] += t.cycles[c];
     auto tl = clock_type::now();
-    if constexpr (std::is_same_v<Sampler, bayes_sampler>)
+    bool changed = false;  // the model of the next pass differs from this one's
+    if constexpr (std::is_same_v<Sampler, bayes_sampler>) {
+      bool was = sampler.fallback;
       sampler.check_fallback(rows.records, result.film, result.film_weight, count, done + count);
-    if constexpr (Sampler::learns) sampler.learn(rows.records);
-    else sampler.end_pass();
+      changed = sampler.fallback != was;
+    }
+    if constexpr (Sampler::learns) {
+      changed = changed || model_moves(sampler);
+      sampler.learn(rows.records);
+    } else {
+      sampler.end_pass();
+    }
+    if (changed) result.stratum_base = done + count;
     result.learn_seconds += seconds_since(tl);
     if constexpr (std::is_same_v<Sampler, bayes_sampler>) result.learn_parts = sampler.timing;
     result.seconds += seconds_since(t0);

@@ -71,7 +71,7 @@ std::string render_summary(const render_result& r, const std::vector<std::string
 
 void report_dropped_triangles(const std::string& mesh_path, int dropped) {
   if (dropped > 0)
-    std::fprintf(stderr, "%s: dropped %d degenerate (zero-area) triangle%s\n", mesh_path.c_str(), dropped,
+    std::fprintf(stderr, "%s: dropped %d degenerate triangle%s (zero area in float, or an area too large for it)\n", mesh_path.c_str(), dropped,
                  dropped == 1 ? "" : "s");
 }
 
