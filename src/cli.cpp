@@ -295,6 +295,17 @@ const CLI::Validator finite_number(
     },
     "");
 
+// A finite number above 0 (CLI::PositiveNumber's message would print the largest double in full).
+const CLI::Validator positive_number(
+    [](std::string& text) -> std::string {
+      char* end = nullptr;
+      double v = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0))
+        return "Value " + text + " is not a positive finite number";
+      return {};
+    },
+    "");
+
 // The options `render` and `compare` share: spp or time, size, depth, threads, seed, quiet, sampler options.
 void add_render_options(CLI::App* r, render_options& o) {
   auto* spp = r->add_option("--spp", o.spp, "Samples per pixel (default: the scene's render.spp)")
@@ -373,11 +384,11 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the prior-only (bound) PMF, in [0, 1] (default 0)")
       ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
   r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (> 0, default 0.3)")
-      ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
+      ->check(positive_number)->group(bg);
   r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (> 0, default 0.03)")
-      ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
+      ->check(positive_number)->group(bg);
   r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (> 0, default 1)")
-      ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
+      ->check(positive_number)->group(bg);
   r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1, default 2)")
       ->check(CLI::Range(1.000001, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-oracle", o.bayes.oracle_spp,
@@ -395,7 +406,7 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "cannot pay for its own cost (default 1.25; 0 = never)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0, default 0.3)")
-      ->check(CLI::PositiveNumber)->check(finite_number)->group(bg);
+      ->check(positive_number)->group(bg);
 }
 
 void add_render_command(CLI::App& app, render_options& o) {

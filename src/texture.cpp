@@ -136,7 +136,11 @@ static void drop_empty_idat_chunks(std::string& b) {
 
 static std::string stb_reason() {
   const char* r = stbi_failure_reason();
-  return r ? r : "unknown error";
+  std::string s = r ? r : "unknown error";
+  // stb_image quotes a corrupt file's own bytes (an unknown chunk's type): keep the message printable.
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+  return s;
 }
 
 // Most texels a file byte may claim (see load_texture).

@@ -25,6 +25,7 @@ variants=(
   "c 1 (prior CV 100%)|--bayes-c 1"
   "earlier defaults (a0 1, b0 1, c 1, hier. 4)|--bayes-a0 1 --bayes-b0 1 --bayes-c 1 --bayes-hierarchy 4"
   "max cut 256|--max-cut 256"
+  "independent samples (no stratified first vertex)|--independent-samples"
   "bound sampler (reference point)|--sampler bound"
 )
 refdir=$(dirname "$bin")/ref; mkdir -p "$refdir"
