@@ -9,11 +9,13 @@
 #include "errors.h"
 #include "obj_validate.h"
 
-#include <algorithm>
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
+#include <array>
 #include <climits>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <istream>
@@ -247,6 +249,51 @@ static tinyobj_result parse_clean(const std::string& path, const obj_clean_data&
   return r;
 }
 
+// Drops emissive triangles that repeat an earlier emissive one exactly (the same three corners in the same cyclic
+// order: the same side emits): light sampling would count every copy while a ray sees one, so next-event and
+// BSDF-sampled estimates of that light would disagree. Returns how many were dropped. Keeps file order.
+static int drop_repeated_emitters(mesh_data& mesh, const std::vector<vec3f>& pos, const std::vector<char>& emissive) {
+  size_t n = mesh.tri_materials.size();
+  // Each emissive triangle's corners as 9 float bit patterns, rotated to start at its smallest corner.
+  auto key = [&](size_t t) {
+    std::array<uint32_t, 9> k{};
+    std::array<std::array<uint32_t, 3>, 3> c{};
+    for (int i = 0; i < 3; i++) {
+      vec3f p = pos[size_t(mesh.tri_positions[3 * t + size_t(i)])];
+      std::memcpy(c[size_t(i)].data(), &p, sizeof p);
+    }
+    int r = 0;
+    for (int i = 1; i < 3; i++)
+      if (c[size_t(i)] < c[size_t(r)]) r = i;
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) k[size_t(3 * i + j)] = c[size_t((r + i) % 3)][size_t(j)];
+    return k;
+  };
+  std::vector<std::pair<std::array<uint32_t, 9>, uint32_t>> keys;
+  for (size_t t = 0; t < n; t++)
+    if (emissive[size_t(mesh.tri_materials[t])]) keys.push_back({key(t), uint32_t(t)});
+  if (keys.size() < 2) return 0;
+  std::sort(keys.begin(), keys.end());
+  std::vector<char> drop(n, 0);
+  int dropped = 0;
+  for (size_t i = 1; i < keys.size(); i++)
+    if (keys[i].first == keys[i - 1].first) drop[keys[i].second] = 1, dropped++;  // sorted by index within a key
+  if (dropped == 0) return 0;
+  size_t out = 0;
+  for (size_t t = 0; t < n; t++) {
+    if (drop[t]) continue;
+    for (int i = 0; i < 3; i++) {
+      mesh.tri_positions[3 * out + size_t(i)] = mesh.tri_positions[3 * t + size_t(i)];
+      mesh.tri_normals[3 * out + size_t(i)] = mesh.tri_normals[3 * t + size_t(i)];
+      mesh.tri_texcoords[3 * out + size_t(i)] = mesh.tri_texcoords[3 * t + size_t(i)];
+    }
+    mesh.tri_materials[out++] = mesh.tri_materials[t];
+  }
+  mesh.tri_positions.resize(3 * out), mesh.tri_normals.resize(3 * out), mesh.tri_texcoords.resize(3 * out);
+  mesh.tri_materials.resize(out);
+  return dropped;
+}
+
 // Builds the mesh from the parsed OBJ: triangles, compacted vertex arrays, materials and textures.
 static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean, const tinyobj_result& parsed) {
   auto position = [&](size_t i) { return clean.positions[i]; };
@@ -288,6 +335,11 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
       }
     }
   }
+  std::vector<char> emissive(clean.materials.size() + 1, 0);  // the last: the default material
+  for (size_t k = 0; k < clean.materials.size(); k++) emissive[k] = !is_black(clean.materials[k].material.ke);
+  if (int repeated = drop_repeated_emitters(mesh, clean.positions, emissive))
+    std::cerr << "warning: " << path << ": dropped " << repeated << " emissive triangle" << (repeated > 1 ? "s" : "")
+              << " repeating an earlier one (same corners, same side), which would light the scene once per copy\n";
   if (st.fan_fallbacks > 0)
     std::cerr << "warning: " << path << ": " << st.fan_fallbacks
               << " polygon(s) too complex to ear-clip in the time budget were fan-triangulated\n";

@@ -185,6 +185,25 @@ TEST_CASE("materials read Kd Ks Ns and Ke and faces without one get the default"
   CHECK(m.tri_materials == std::vector<int>{2, 0, 1, 0});
 }
 
+TEST_CASE("an emissive triangle repeating an earlier one is dropped, other repeats are kept", "[obj]") {
+  // Light sampling would count every copy of a lamp while a ray sees one of them.
+  temp_dir dir;
+  dir.write("m.mtl", "newmtl lamp\nKe 5 5 5\nnewmtl wall\nKd 0.5 0.5 0.5\n");
+  auto obj = dir.write("m.obj", "mtllib m.mtl\n" + std::string(square_vertices) +
+                                    "v 0 0 0\n"  // a second vertex at corner 1's place: repeats by position count
+                                    "usemtl lamp\nf 1 2 3\nf 2 3 1\nf 5 2 3\nf 3 2 1\n"  // same, rotated, copy, reversed
+                                    "usemtl wall\nf 1 2 3\nf 1 2 3\n");                  // non-emissive repeats
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  // Kept: the first lamp triangle, its reversed twin (the other side emits), both walls.
+  REQUIRE(triangle_count(m) == 4);
+  CHECK(m.materials[size_t(m.tri_materials[0])].name == "lamp");
+  CHECK(m.materials[size_t(m.tri_materials[1])].name == "lamp");
+  CHECK(dot(area_vector(m, 0), area_vector(m, 1)) < 0);
+  CHECK(m.materials[size_t(m.tri_materials[2])].name == "wall");
+  CHECK(m.materials[size_t(m.tri_materials[3])].name == "wall");
+}
+
 TEST_CASE("a file without usemtl has only the default material", "[obj]") {
   temp_dir dir;
   mesh_data m = load_obj(dir.write("plain.obj", std::string(square_vertices) + "f 1 2 3 4\n"));
