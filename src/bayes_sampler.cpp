@@ -292,12 +292,13 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     // A window is complete: its ratio votes.
     bool valid = window_var > 0 && std::isfinite(window_var) && std::isfinite(window_delta);
     check_ratio = valid ? (window_var + window_delta) / window_var : 0.0;
-    bool below = valid && window_var + window_delta < params.fallback_ratio * window_var;
+    const double threshold = params.fallback_ratio * (params.stratified ? params.fallback_stratified : 1.0);
+    bool below = valid && window_var + window_delta < threshold * window_var;
     fallback_votes = below ? fallback_votes + 1 : 0;
     window_var = window_delta = window_samples = 0;
     fallback = fallback_votes >= 2;
     if (fallback) fallback_spp = spp;
-    check_done = valid && check_ratio >= 2 * params.fallback_ratio;
+    check_done = valid && check_ratio >= 2 * threshold;
     if (fallback || check_done) {
       px_var = {};
       px_delta = {};

@@ -49,6 +49,11 @@ struct bayes_params {
                                  // per sample of power sampling is below this many times the learned one's in two
                                  // check windows in a row (from 4 spp on): where learning cannot pay for its own
                                  // cost (bayes costs 1.4-2.6x power's time per sample on the data/ scenes); 0: never
+  double fallback_stratified = 2;  // the threshold's factor when the first vertex is stratified (the default): the
+                                   // check estimates both sides as if samples were independent, but stratification
+                                   // helps a fixed choice more (the Cornell box, direct: estimated 1.86x, about 1.3x
+                                   // measured against stratified power); 1 with --independent-samples
+  bool stratified = true;          // set from the render (render_inputs::stratify)
   double fallback_window = 262144;  // samples (pixels x spp) a fallback check sums before it votes: the events that
                                     // make power sampling bad can be rare (points by a lamp's rim)
   bool control_variate = true;   // region prior only: where NEE is unweighted (direct illumination, the last path

@@ -112,6 +112,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.sun_sin = sun_sin;
       s.sun_cos = sun_cos;
       s.params = params.bayes;
+      s.params.stratified = in.stratify;
       s.power = power_sampler{make_discrete(lights.power.data(), lights.count)};
       if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
         s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);

@@ -16,10 +16,12 @@ using namespace bl::test;
 
 namespace {
 
-// A sampler with only what the check reads: power sampling over two lights of power 1 and 3.
-bayes_sampler two_light_sampler(double ratio, double window = 1) {
+// A sampler with only what the check reads: power sampling over two lights of power 1 and 3. `stratified`: the
+// render stratifies its first vertex (the threshold is then fallback_ratio times fallback_stratified).
+bayes_sampler two_light_sampler(double ratio, double window = 1, bool stratified = false) {
   bayes_sampler s;
   s.params.fallback_ratio = ratio;
+  s.params.stratified = stratified;
   s.params.fallback_window = window;  // 1: every checked pass is a window of its own
   s.power = power_sampler{make_discrete(std::vector<float>{1, 3}.data(), 2)};
   return s;
@@ -122,6 +124,15 @@ TEST_CASE("the fallback decision needs two check windows in a row below the thre
   CHECK(s.fallback_spp == 12);
   CHECK(s.px_var.empty());  // nothing more is checked or recorded
   CHECK(s.px_delta.empty());
+
+  // With a stratified first vertex the threshold is doubled (2.5): the ratio 2.0 votes below it.
+  bayes_sampler st = two_light_sampler(1.25, 1, true);
+  st.check_fallback(rows, film, 1.0, 1, 1);
+  above(st, 2, 5);
+  CHECK(st.fallback_votes == 1);
+  above(st, 2, 7);
+  CHECK(st.fallback);
+  CHECK(st.fallback_spp == 7);
 
   // A pass whose variance is zero or whose sums are not finite decides nothing; a pass of one spp without the pass
   // before it kept is not checked.
