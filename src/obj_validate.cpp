@@ -8,6 +8,7 @@
 #include "errors.h"
 #include "file_io.h"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdlib>
@@ -318,6 +319,15 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       if ((k == "d" || k == "Tr") && !(v >= 0 && v <= 1)) fail(pos, quote(k) + " must lie in [0, 1]");
       if (k == "Ns") m.ns = v;
       if (((k == "d" && v < 1) || (k == "Tr" && v > 0)) && transparent_line == 0) transparent_line = lines.line;
+    }
+  }
+  // Kd + Ks above 1 reflects more than arrives: make_bsdf scales such a material down (said once per file).
+  for (size_t i = first; i < out.size(); i++) {
+    const material_data& m = out[i].material;
+    if (std::max({m.kd.x + m.ks.x, m.kd.y + m.ks.y, m.kd.z + m.ks.z}) > 1) {
+      std::cerr << "warning: " << path << ": material " << quote(m.name)
+                << " has Kd + Ks above 1, scaled down to conserve energy\n";
+      break;
     }
   }
   if (transparent_line > 0)

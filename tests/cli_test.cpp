@@ -291,6 +291,16 @@ TEST_CASE("inputs that are not regular files are refused, never read", "[cli]") 
   }
 }
 
+TEST_CASE("materials the renderer changes or ignores are named in a warning", "[cli]") {
+  tiny_scene s;
+  write_text(s.dir / "box.mtl", "newmtl floor\nKd 0.9 0.5 0.5\nKs 0.3\nd 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
+  auto r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "o.pfm"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("material 'floor' has Kd + Ks above 1, scaled down to conserve energy") != std::string::npos);
+  CHECK(r.output.find("box.mtl:4: dissolve") != std::string::npos);
+}
+
 TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
   tiny_scene s;
   auto r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "no/such/dir/out.exr"));
