@@ -52,6 +52,7 @@ struct compare_sampler {
 struct compare_data {
   std::vector<compare_sampler> samplers;  // in the order given
   bool equal_time = false;                // --time budget (else equal spp)
+  double time_budget = 0;                 // that budget, seconds
   int signal = 0;                         // the SIGINT/SIGTERM that cut it short (0: complete)
 };
 
@@ -63,11 +64,17 @@ struct compare_stats {
   int runs = 0;                      // runs with at least one pass
   int spp_min = 0, spp_max = 0;      // final spp over runs
   double seconds = 0;                // mean final render time
-  double relmse = 0, relmse_sd = 0;  // mean and sample standard deviation of the final relMSE
+  double relmse = 0, relmse_sd = 0;  // mean and sample standard deviation over runs of the relMSE at the end: at
+                                     // exactly the time budget (relmse_at_time) at equal time, else the final one
   double setup_seconds = 0;          // mean setup time (light tree, regions; not in `seconds`)
   double speedup = 0;                // against the first sampler (NaN when undefined)
-  double time_to_target = -1;        // seconds until it stays at or below the first sampler's final relMSE
+  double time_to_target = -1;        // seconds until it stays at or below the first sampler's relmse
 };
+
+// A run's relMSE at exactly time t: log-log interpolation between the last pass before t and the first at or after
+// it (a --time run ends with the first whole pass past t); the first pass's when it already ends past t, the last
+// pass's when the run ended sooner (interrupted).
+double relmse_at_time(const std::vector<pass_record>& log, double t);
 
 // Renders every (run, sampler) one at a time; stops early on SIGINT/SIGTERM (data.signal).
 compare_data run_comparison(const scene_data& scene, const bvh_data& bvh, const light_data& lights,

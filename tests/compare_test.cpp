@@ -208,8 +208,11 @@ std::string xml_problem(const std::string& s) {
 // Whether xmllint is on this machine.
 bool have_xmllint() { return std::system("command -v xmllint >/dev/null 2>&1") == 0; }
 
-// Checks everything a comparison wrote into out: files, CSV rows per sampler and run, summary = CSV's last rows.
-void check_outputs(const std::string& out, const std::vector<std::string>& samplers, int runs, bool equal_time) {
+// Checks everything a comparison wrote into out: files, CSV rows per sampler and run, summary = CSV's last rows
+// (relMSE: at exactly the budget at equal time, between the passes around it).
+// budget: the --time of an equal-time comparison (0: equal spp).
+void check_outputs(const std::string& out, const std::vector<std::string>& samplers, int runs, double budget) {
+  const bool equal_time = budget > 0;
   for (const char* name : {"curves.csv", "error_vs_time.svg", "summary.md"})
     CHECK(std::filesystem::exists(out + "/" + std::string(name)));
   std::vector<csv_row> rows = read_curves(out + "/curves.csv");
@@ -222,8 +225,11 @@ void check_outputs(const std::string& out, const std::vector<std::string>& sampl
     const std::string& s = samplers[k];
     // Rows of every run, passes numbered 1, 2, ... with growing spp and time.
     std::vector<const csv_row*> last;
+    std::vector<double> at_end;  // each run's relMSE at the end: at exactly the budget at equal time
     for (int run = 1; run <= runs; run++) {
       const csv_row* prev = nullptr;
+      const csv_row* before = nullptr;  // the last pass before the budget, and the first at or after it
+      const csv_row* after = nullptr;
       for (const csv_row& r : rows) {
         if (r.sampler != s || r.run != run) continue;
         CHECK(r.pass == (prev ? prev->pass + 1 : 1));
@@ -232,20 +238,31 @@ void check_outputs(const std::string& out, const std::vector<std::string>& sampl
         CHECK(r.relmse > 0);
         CHECK(r.mse > 0);
         prev = &r;
+        if (r.seconds < budget) before = &r;
+        else if (!after) after = &r;
       }
       REQUIRE(prev != nullptr);
       last.push_back(prev);
+      double e = prev->relmse;
+      if (equal_time && after && before) {
+        double f = std::log(budget / before->seconds) / std::log(after->seconds / before->seconds);
+        e = std::exp(std::log(before->relmse) + f * std::log(after->relmse / before->relmse));
+      } else if (equal_time && after) {
+        e = after->relmse;
+      }
+      at_end.push_back(e);
     }
     // The summary's numbers are those of the runs' last rows (means over runs).
     const std::vector<std::string>& cells = table.at(s);
     double relmse = 0, seconds = 0;
-    for (const csv_row* r : last) relmse += r->relmse / runs, seconds += r->seconds / runs;
+    for (const csv_row* r : last) seconds += r->seconds / runs;
+    for (double e : at_end) relmse += e / runs;
     CHECK(std::stoi(cells[1]) == last[0]->spp);
     CHECK(std::stod(cells[2]) == Approx(seconds).epsilon(1e-3).margin(2e-6));
     CHECK(std::stod(cells[3]) == Approx(relmse).epsilon(2e-4));
     if (runs > 1) {
       double var = 0;
-      for (const csv_row* r : last) var += (r->relmse - relmse) * (r->relmse - relmse) / (runs - 1);
+      for (double e : at_end) var += (e - relmse) * (e - relmse) / (runs - 1);
       size_t pm = cells[3].find("\xc2\xb1");
       REQUIRE(pm != std::string::npos);
       CHECK(std::stod(cells[3].substr(pm + 2)) == Approx(std::sqrt(var)).epsilon(1e-2));
@@ -287,7 +304,7 @@ TEST_CASE("compare at equal spp writes curves summary plot and images", "[compar
                                 " --spp 4 --samplers uniform,power,bvh --out " + out + " --threads 2 --quiet");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  check_outputs(out, {"uniform", "power", "bvh"}, 1, false);
+  check_outputs(out, {"uniform", "power", "bvh"}, 1, 0);
   std::vector<csv_row> rows = read_curves(out + "/curves.csv");
   CHECK(rows.size() == 12);  // 4 passes of 1 spp for each sampler
   for (const csv_row& row : rows) CHECK(row.seed == 0);  // the scene's seed
@@ -307,7 +324,7 @@ TEST_CASE("compare repeats runs with consecutive seeds and reports mean and devi
                                 " --reference-note 'reference: 16 spp uniform, seed 99' --quiet");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  check_outputs(out, {"power", "bayes"}, 3, false);
+  check_outputs(out, {"power", "bayes"}, 3, 0);
   std::vector<csv_row> rows = read_curves(out + "/curves.csv");
   CHECK(rows.size() == 2 * 3 * 3);
   for (const csv_row& row : rows) CHECK(row.seed == 7 + unsigned(row.run) - 1);
@@ -326,7 +343,7 @@ TEST_CASE("compare at equal time gives every sampler the same budget", "[compare
                                 " --time 0.05 --samplers bound,uniform --out " + out + " --quiet");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  check_outputs(out, {"bound", "uniform"}, 1, true);
+  check_outputs(out, {"bound", "uniform"}, 1, 0.05);
   for (const csv_row& row : read_curves(out + "/curves.csv")) CHECK(row.seconds > 0);
   std::map<std::string, double> final_seconds;
   for (const csv_row& row : read_curves(out + "/curves.csv")) final_seconds[row.sampler] = row.seconds;
