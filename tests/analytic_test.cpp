@@ -57,6 +57,13 @@ camera_params looking_down(float h) {
   return c;
 }
 
+// Radiance leaving a Lambertian floor of albedo rho at the point under the centre of a square emitter of side 2a,
+// radiance le, at height h facing it: rho E / pi with E = 4 le A / sqrt(1 + A^2) atan(A / sqrt(1 + A^2)), A = a / h.
+double under_square_lamp(double a, double h, double le, double rho) {
+  double A = a / h, s = A / std::sqrt(1 + A * A);
+  return rho / M_PI * 4 * le * s * std::atan(s);
+}
+
 const sampler_kind kinds[] = {sampler_kind::uniform, sampler_kind::power,    sampler_kind::bvh,
                               sampler_kind::bound,   sampler_kind::donikian, sampler_kind::bayes};
 
@@ -64,7 +71,6 @@ const sampler_kind kinds[] = {sampler_kind::uniform, sampler_kind::power,    sam
 
 TEST_CASE("a point under a large emitting square receives the closed form irradiance", "[analytic]") {
   // Square of side 2a at height h, radiance Le, facing down onto a Lambertian floor of albedo rho.
-  // E = 4 Le A / sqrt(1 + A^2) atan(A / sqrt(1 + A^2)), A = a / h; outgoing radiance rho E / pi.
   const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
   for (sampler_kind kind : kinds)
     for (int depth : {1, 2}) {
@@ -75,8 +81,7 @@ TEST_CASE("a point under a large emitting square receives the closed form irradi
       b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
       b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);  // normal -y: faces the floor
       b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, dim);       // faces up: never lights the floor
-      double A = a / h, s = A / std::sqrt(1 + A * A);
-      double exact = rho / M_PI * 4 * le * s * std::atan(s);
+      double exact = under_square_lamp(a, h, le, rho);
       INFO("sampler " << sampler_name(kind) << " depth " << depth);
       check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, depth, 1024), exact);
     }
@@ -105,8 +110,7 @@ TEST_CASE("the holes of an emitter's own map_d emit nothing", "[analytic]") {
       mask.alpha = {1.0f, 0.0f};
       b.mesh.textures.push_back(mask);
       b.mesh.materials[size_t(lamp)].alpha_texture = 0;
-      double A = a / h, s = A / std::sqrt(1 + A * A);
-      double exact = 0.5 * rho / M_PI * 4 * le * s * std::atan(s);
+      double exact = 0.5 * under_square_lamp(a, h, le, rho);
       INFO("sampler " << sampler_name(kind) << " depth " << depth);
       check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, depth, 1024), exact);
     }
@@ -125,8 +129,7 @@ TEST_CASE("a lamp just above a floor far from the origin gives the closed form i
     b.add_quad(c + vec3f{-a, h, -a}, c + vec3f{a, h, -a}, c + vec3f{a, h, a}, c + vec3f{-a, h, a}, lamp);
     // The closed form for the geometry as stored (float coordinates near 1000 are 6e-5 apart).
     double hs = double(c.y + h) - double(c.y), as = double(c.x + a) - double(c.x);
-    double A = as / hs, s = A / std::sqrt(1 + A * A);
-    double exact = rho / M_PI * 4 * le * s * std::atan(s);
+    double exact = under_square_lamp(as, hs, le, rho);
     camera_params cam;
     cam.automatic = false;
     cam.eye = c + vec3f{0, 0.005f, 0};
