@@ -90,15 +90,15 @@ inline bool unoccluded(const render_inputs& in, const surface_point& sp, const l
 // reuse per-point work between neighbouring samples (e.g. a region lookup). `tm` times the hot path's stages
 // (profile_timers.h; no_timers compiles every timer away).
 template <class Sampler, class Sink, class Timers>
-vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample,
-                       path_stats& st, Sink& sink, typename Sampler::context (&ctxs)[2], Timers& tm) {
+vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, int y, const pixel_streams& ps,
+                       uint64_t sample, path_stats& st, Sink& sink, typename Sampler::context (&ctxs)[2], Timers& tm) {
   const scene_data& scene = *in.scene;
   const light_data& lights = *in.lights;
   int pixel = y * in.camera.width + x;
-  uint64_t key = sample_key(in.seed, uint64_t(pixel), sample);
+  uint64_t key = sample_key_from(ps.key_base, sample);
   uint64_t t0 = tm.start();
   float jx, jy;
-  pixel_jitter(in.seed, uint64_t(pixel), sample, jx, jy);
+  jitter_at(ps.shift_x, ps.shift_y, sample, jx, jy);
   vec3f org = in.camera.eye;
   vec3f dir = camera_ray_dir(in.camera, float(x) + jx, float(y) + jy);
   st.camera_rays++;
@@ -145,7 +145,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     vertex_randoms r = draw_vertex(key, uint32_t(depth));
     bool last = depth >= in.max_depth;
     if (depth == 1 && in.stratify)
-      stratify_first_vertex(in.stratum_key, uint64_t(pixel), uint32_t(sample - in.stratum_base), last, r);
+      stratify_with(ps.strata, uint32_t(sample - in.stratum_base), last, r);
     typename Sampler::context& ctx = ctxs[depth & 1];
     shade_point spt{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth, last};
     tm.stop(prof_shading, t0);
@@ -235,12 +235,13 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
   return radiance;
 }
 
-// trace_path_timed without timers (renders).
+// trace_path_timed without timers, computing the pixel's streams itself (tests; renders compute them once per pixel).
 template <class Sampler, class Sink>
 vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample, path_stats& st,
                  Sink& sink, typename Sampler::context (&ctxs)[2]) {
   no_timers tm;
-  return trace_path_timed(in, sampler, x, y, sample, st, sink, ctxs, tm);
+  pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * in.camera.width + x));
+  return trace_path_timed(in, sampler, x, y, ps, sample, st, sink, ctxs, tm);
 }
 
 }  // namespace bl

@@ -91,8 +91,9 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
             std::conditional_t<Profile, cycle_timers, no_timers> tm;
             for (int x = 0; x < w; x++) {
               double sum[3] = {0, 0, 0};
+              const pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * w + x));
               for (int s = s0; s < s1; s++) {
-                vec3f l = trace_path_timed(in, sampler, x, y, uint64_t(s), st, sink, ctxs, tm);
+                vec3f l = trace_path_timed(in, sampler, x, y, ps, uint64_t(s), st, sink, ctxs, tm);
                 sink.sample_done(y * w + x, l);
                 sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
               }

@@ -50,8 +50,11 @@ inline uint64_t mix64(uint64_t z) {
 }
 
 // The PCG32 key of sample `sample` of pixel `pixel` under render seed `seed`.
+// (Its per-pixel part, pixel_key_base, is what pixel_streams caches.)
+inline uint64_t pixel_key_base(uint64_t seed, uint64_t pixel) { return mix64(mix64(seed) ^ pixel); }
+inline uint64_t sample_key_from(uint64_t base, uint64_t sample) { return mix64(base ^ (sample * 0x632be59bd9b4e019ull)); }
 inline uint64_t sample_key(uint64_t seed, uint64_t pixel, uint64_t sample) {
-  return mix64(mix64(mix64(seed) ^ pixel) ^ (sample * 0x632be59bd9b4e019ull));
+  return sample_key_from(pixel_key_base(seed, pixel), sample);
 }
 
 // Uniform float in [0, 1) from the top 24 bits of a 32-bit draw (exactly representable).
@@ -102,12 +105,21 @@ inline uint32_t sobol_second(uint32_t i) {
 // pixel's key. Each sample is uniform over the pixel (unbiased), the shift is independent between pixels, and any
 // 2^k consecutive samples from a multiple of 2^k are stratified (one per cell of every 2^a x 2^b grid with a + b = k),
 // which takes most of the variance off pixels that straddle an edge (a lamp's rim against a dark ceiling).
-inline void pixel_jitter(uint64_t seed, uint64_t pixel, uint64_t sample, float& u, float& v) {
+// (The shift is per pixel: jitter_shift draws it, jitter_at applies it; pixel_streams caches it.)
+inline void jitter_shift(uint64_t seed, uint64_t pixel, uint32_t& sx, uint32_t& sy) {
   pcg32 rng(mix64(mix64(seed ^ 0x6a09e667f3bcc909ull) ^ pixel), 0);
-  uint32_t sx = rng(), sy = rng();
+  sx = rng();
+  sy = rng();
+}
+inline void jitter_at(uint32_t sx, uint32_t sy, uint64_t sample, float& u, float& v) {
   uint32_t i = uint32_t(sample);
   u = uint_to_unit(reverse_bits(i) ^ sx);
   v = uint_to_unit(sobol_second(i) ^ sy);
+}
+inline void pixel_jitter(uint64_t seed, uint64_t pixel, uint64_t sample, float& u, float& v) {
+  uint32_t sx, sy;
+  jitter_shift(seed, pixel, sx, sy);
+  jitter_at(sx, sy, sample, u, v);
 }
 
 // A nested uniform scramble of x from its low bit up: bit k of the result is bit k of x flipped by a function of
@@ -149,17 +161,44 @@ inline uint64_t stratum_key_of(uint64_t seed, uint64_t base) {
 // dimensions of r. Each of the three has its own shuffle and shifts, from the pixel's hash; each sample stays
 // uniform, so any estimator stays unbiased, and 2^k consecutive samples from a multiple of 2^k are stratified.
 // The inner choice inside a cluster, the lobe and roulette keep their independent draws.
-inline void stratify_first_vertex(uint64_t key, uint64_t pixel, uint32_t index, bool last, vertex_randoms& r) {
+// The three sets' hashes are per (set, pixel): stratum_hashes computes them, stratify_with applies them.
+struct stratum_hashes {
+  uint64_t select = 0, point = 0, bsdf = 0;
+};
+inline stratum_hashes stratum_hashes_of(uint64_t key, uint64_t pixel) {
   uint64_t k = mix64(key ^ pixel);
-  r.raw[dim_light_select] = shuffled_vdc(index, mix64(k + 1));
-  sobol_pair(index, mix64(k + 2), r.raw[dim_light_u], r.raw[dim_light_v]);
+  return {mix64(k + 1), mix64(k + 2), mix64(k + 3)};
+}
+inline void stratify_with(const stratum_hashes& hs, uint32_t index, bool last, vertex_randoms& r) {
+  r.raw[dim_light_select] = shuffled_vdc(index, hs.select);
+  sobol_pair(index, hs.point, r.raw[dim_light_u], r.raw[dim_light_v]);
   r.u[dim_light_select] = uint_to_unit(r.raw[dim_light_select]);
   r.u[dim_light_u] = uint_to_unit(r.raw[dim_light_u]);
   r.u[dim_light_v] = uint_to_unit(r.raw[dim_light_v]);
   if (last) return;
-  sobol_pair(index, mix64(k + 3), r.raw[dim_bsdf_u], r.raw[dim_bsdf_v]);
+  sobol_pair(index, hs.bsdf, r.raw[dim_bsdf_u], r.raw[dim_bsdf_v]);
   r.u[dim_bsdf_u] = uint_to_unit(r.raw[dim_bsdf_u]);
   r.u[dim_bsdf_v] = uint_to_unit(r.raw[dim_bsdf_v]);
+}
+inline void stratify_first_vertex(uint64_t key, uint64_t pixel, uint32_t index, bool last, vertex_randoms& r) {
+  stratify_with(stratum_hashes_of(key, pixel), index, last, r);
+}
+
+// What a pixel's samples share, computed once per pixel and pass (the per-pixel parts of sample_key, pixel_jitter
+// and stratify_first_vertex), so that a sample draws exactly what those functions give.
+struct pixel_streams {
+  uint64_t pixel = 0;
+  uint64_t key_base = 0;          // pixel_key_base
+  uint32_t shift_x = 0, shift_y = 0;  // jitter_shift
+  stratum_hashes strata;          // stratum_hashes_of the pass's set
+};
+inline pixel_streams pixel_streams_of(uint64_t seed, uint64_t stratum_key, uint64_t pixel) {
+  pixel_streams ps;
+  ps.pixel = pixel;
+  ps.key_base = pixel_key_base(seed, pixel);
+  jitter_shift(seed, pixel, ps.shift_x, ps.shift_y);
+  ps.strata = stratum_hashes_of(stratum_key, pixel);
+  return ps;
 }
 
 }  // namespace bl
