@@ -503,6 +503,18 @@ int run_compare_command(const compare_options& o) {
   cp.reference_note = o.reference_note;
   cp.out_dir = o.out;
   cp.quiet = o.render.quiet;
+  {
+    // The files compare writes into --out must not be its inputs (a reference kept there as <sampler>.exr).
+    std::vector<std::pair<std::string, std::string>> outs, ins = {
+        {o.render.scene, "scene file"}, {desc.mesh_path, "scene input"}, {o.render.reference, "reference"}};
+    for (sampler_kind k : cp.samplers) {
+      outs.push_back({(fs::path(o.out) / (std::string(sampler_name(k)) + ".exr")).string(), "output"});
+      outs.push_back({(fs::path(o.out) / (std::string(sampler_name(k)) + "_error.png")).string(), "output"});
+    }
+    for (const char* f : {"curves.csv", "error_vs_time.svg", "summary.md"})
+      outs.push_back({(fs::path(o.out) / f).string(), "output"});
+    check_distinct_outputs(outs, ins);
+  }
   return run_compare(desc, cp);
 }
 

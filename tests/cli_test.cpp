@@ -265,6 +265,17 @@ TEST_CASE("outputs that would overwrite an input or each other are refused befor
   CHECK(read_text(s.dir / "floor.png") == tex);
   CHECK(read_text(s.dir / "ref.pfm") == ref);
   CHECK(!exists(s.dir / "a.pfm"));
+  // compare writes <sampler>.exr and its other files into --out: a reference kept there under such a name.
+  std::filesystem::create_directory(s.dir / "cmp");
+  REQUIRE(run_bayeslight("render " + sc + " --quiet --spp 2 -o " + (s.dir / "cmp/bayes.exr")).status == 0);
+  const std::string kept = read_text(s.dir / "cmp/bayes.exr");
+  auto cmp = run_bayeslight("compare " + sc + " --quiet --spp 1 --samplers uniform,bayes --reference " +
+                            (s.dir / "cmp/bayes.exr") + " --out " + (s.dir / "cmp"));
+  INFO(cmp.output);
+  CHECK(cmp.status == 2);
+  CHECK(cmp.output.find("would overwrite the reference") != std::string::npos);
+  CHECK(read_text(s.dir / "cmp/bayes.exr") == kept);
+  CHECK(!exists(s.dir / "cmp/summary.md"));
   // The one overlap allowed: a checkpoint resumed from and written again.
   std::string ck = s.dir / "ck.bin";
   REQUIRE(run_bayeslight("render " + sc + " --quiet --checkpoint " + ck + " -o " + (s.dir / "b.pfm")).status == 0);
