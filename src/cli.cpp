@@ -97,31 +97,6 @@ void check_output_path(const std::string& path) {
   if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write " + path + ": directory " + dir.string() + " is not writable");
 }
 
-// The same file, whether or not it exists yet (symbolic links and "." / ".." resolved).
-bool same_file(const std::string& a, const std::string& b) {
-  std::error_code ea, eb;
-  fs::path pa = fs::weakly_canonical(fs::absolute(a), ea), pb = fs::weakly_canonical(fs::absolute(b), eb);
-  if (ea || eb) return fs::path(a).lexically_normal() == fs::path(b).lexically_normal();
-  return pa == pb;
-}
-
-// Refuses a render whose outputs would overwrite one of its inputs or one another (exit 2, before any work).
-// Files are (path, role) pairs; the one overlap allowed is a checkpoint resumed from and written again.
-constexpr const char* resumed_role = "checkpoint resumed from";
-void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs,
-                            const std::vector<std::pair<std::string, std::string>>& inputs) {
-  for (size_t i = 0; i < outputs.size(); i++) {
-    for (const auto& in : inputs)
-      if (!(in.second == resumed_role && outputs[i].second == "checkpoint") && same_file(outputs[i].first, in.first))
-        throw usage_error(outputs[i].second + " " + outputs[i].first + " would overwrite the " + in.second + " " +
-                          in.first);
-    for (size_t j = 0; j < i; j++)
-      if (same_file(outputs[i].first, outputs[j].first))
-        throw usage_error(outputs[i].second + " " + outputs[i].first + " is also the " + outputs[j].second + " " +
-                          outputs[j].first);
-  }
-}
-
 // The validated render parameters of a scene and the command line.
 render_params resolve_params(const render_options& o, const scene_desc& desc, sampler_kind kind) {
   render_params p;
@@ -503,18 +478,6 @@ int run_compare_command(const compare_options& o) {
   cp.reference_note = o.reference_note;
   cp.out_dir = o.out;
   cp.quiet = o.render.quiet;
-  {
-    // The files compare writes into --out must not be its inputs (a reference kept there as <sampler>.exr).
-    std::vector<std::pair<std::string, std::string>> outs, ins = {
-        {o.render.scene, "scene file"}, {desc.mesh_path, "scene input"}, {o.render.reference, "reference"}};
-    for (sampler_kind k : cp.samplers) {
-      outs.push_back({(fs::path(o.out) / (std::string(sampler_name(k)) + ".exr")).string(), "output"});
-      outs.push_back({(fs::path(o.out) / (std::string(sampler_name(k)) + "_error.png")).string(), "output"});
-    }
-    for (const char* f : {"curves.csv", "error_vs_time.svg", "summary.md"})
-      outs.push_back({(fs::path(o.out) / f).string(), "output"});
-    check_distinct_outputs(outs, ins);
-  }
   return run_compare(desc, cp);
 }
 

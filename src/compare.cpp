@@ -273,6 +273,17 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   image_data reference = read_reference(params.reference_path, rp.width, rp.height);
   scene_data scene = build_scene(desc, float(rp.width) / float(rp.height));
   report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
+  {
+    // The files written into --out must not be inputs (e.g. a reference kept there as <sampler>.exr).
+    std::vector<std::pair<std::string, std::string>> outs, ins = {{params.scene_path, "scene file"},
+                                                                  {params.reference_path, "reference"}};
+    for (const std::string& src : scene.mesh.source_files) ins.push_back({src, "scene input"});
+    for (sampler_kind k : params.samplers)
+      for (const char* suffix : {".exr", "_error.png"})
+        outs.push_back({out_path(params, std::string(sampler_name(k)) + suffix), "output"});
+    for (const char* f : {"curves.csv", "error_vs_time.svg", "summary.md"}) outs.push_back({out_path(params, f), "output"});
+    check_distinct_outputs(outs, ins);
+  }
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
   if (lights.count == 0)

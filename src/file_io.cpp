@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <filesystem>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -147,6 +148,28 @@ void write_file_atomic(const std::string& path, const std::string& bytes) {
   if (err != 0) {
     ::unlink(tmp.c_str());
     throw write_failure(path, reason(err));
+  }
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ea, eb;
+  fs::path pa = fs::weakly_canonical(fs::absolute(a), ea), pb = fs::weakly_canonical(fs::absolute(b), eb);
+  if (ea || eb) return fs::path(a).lexically_normal() == fs::path(b).lexically_normal();
+  return pa == pb;
+}
+
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs,
+                            const std::vector<std::pair<std::string, std::string>>& inputs) {
+  for (size_t i = 0; i < outputs.size(); i++) {
+    for (const auto& in : inputs)
+      if (!(in.second == resumed_role && outputs[i].second == "checkpoint") && same_file(outputs[i].first, in.first))
+        throw usage_error(outputs[i].second + " " + outputs[i].first + " would overwrite the " + in.second + " " +
+                          in.first);
+    for (size_t j = 0; j < i; j++)
+      if (same_file(outputs[i].first, outputs[j].first))
+        throw usage_error(outputs[i].second + " " + outputs[i].first + " is also the " + outputs[j].second + " " +
+                          outputs[j].first);
   }
 }
 

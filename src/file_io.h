@@ -5,6 +5,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace bl {
 
@@ -17,5 +19,14 @@ std::string read_file(const std::string& path);
 // checks every write, fsyncs and closes it, then renames it over path. A symlink to a regular file is kept and
 // its target replaced. Throws output_error("cannot write PATH: reason") on any failure.
 void write_file_atomic(const std::string& path, const std::string& bytes);
+
+// The same file, whether or not it exists yet (symbolic links and "." / ".." resolved).
+bool same_file(const std::string& a, const std::string& b);
+// Refuses (usage_error, exit 2, before any work) outputs that would overwrite one of the inputs or one another.
+// Files are (path, role) pairs; the one overlap allowed is a checkpoint (output role "checkpoint") resumed from
+// (input role resumed_role) and written again.
+inline constexpr const char* resumed_role = "checkpoint resumed from";
+void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs,
+                            const std::vector<std::pair<std::string, std::string>>& inputs);
 
 }  // namespace bl

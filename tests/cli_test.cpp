@@ -276,6 +276,18 @@ TEST_CASE("outputs that would overwrite an input or each other are refused befor
   CHECK(cmp.output.find("would overwrite the reference") != std::string::npos);
   CHECK(read_text(s.dir / "cmp/bayes.exr") == kept);
   CHECK(!exists(s.dir / "cmp/summary.md"));
+  // ... and a texture there named like an error image (the scene's inputs are known once it is loaded).
+  write_image(s.dir / "cmp/uniform_error.png", grey);
+  write_text(s.dir / "tex2.mtl", "newmtl floor\nKd 0.5 0.5 0.5\nmap_Kd cmp/uniform_error.png\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
+  write_text(s.dir / "tex2.obj", "mtllib tex2.mtl\n" + obj.substr(obj.find('\n') + 1));
+  write_text(s.dir / "tex2.json", "{\"mesh\": \"tex2.obj\", \"image\": {\"width\": 8, \"height\": 6}}");
+  const std::string texture = read_text(s.dir / "cmp/uniform_error.png");
+  auto cmp2 = run_bayeslight("compare " + (s.dir / "tex2.json") + " --quiet --spp 1 --samplers uniform --reference " +
+                             (s.dir / "ref.pfm") + " --out " + (s.dir / "cmp"));
+  INFO(cmp2.output);
+  CHECK(cmp2.status == 2);
+  CHECK(cmp2.output.find("would overwrite the scene input") != std::string::npos);
+  CHECK(read_text(s.dir / "cmp/uniform_error.png") == texture);
   // The one overlap allowed: a checkpoint resumed from and written again.
   std::string ck = s.dir / "ck.bin";
   REQUIRE(run_bayeslight("render " + sc + " --quiet --checkpoint " + ck + " -o " + (s.dir / "b.pfm")).status == 0);
