@@ -187,14 +187,12 @@ inline void stratify_first_vertex(uint64_t key, uint64_t pixel, uint32_t index, 
 // What a pixel's samples share, computed once per pixel and pass (the per-pixel parts of sample_key, pixel_jitter
 // and stratify_first_vertex), so that a sample draws exactly what those functions give.
 struct pixel_streams {
-  uint64_t pixel = 0;
   uint64_t key_base = 0;          // pixel_key_base
   uint32_t shift_x = 0, shift_y = 0;  // jitter_shift
   stratum_hashes strata;          // stratum_hashes_of the pass's set
 };
 inline pixel_streams pixel_streams_of(uint64_t seed, uint64_t stratum_key, uint64_t pixel) {
   pixel_streams ps;
-  ps.pixel = pixel;
   ps.key_base = pixel_key_base(seed, pixel);
   jitter_shift(seed, pixel, ps.shift_x, ps.shift_y);
   ps.strata = stratum_hashes_of(stratum_key, pixel);
