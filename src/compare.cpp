@@ -245,15 +245,26 @@ std::string comparison_svg(const compare_data& data, const compare_params& p) {
   return loglog_plot_svg(series, pp);
 }
 
+// The files compare writes into the output directory: per sampler its image and error image, then the reports.
+static std::string image_file(const compare_params& p, sampler_kind k) {
+  return out_path(p, std::string(sampler_name(k)) + ".exr");
+}
+static std::string error_file(const compare_params& p, sampler_kind k) {
+  return out_path(p, std::string(sampler_name(k)) + "_error.png");
+}
+static constexpr const char* curves_file = "curves.csv";
+static constexpr const char* plot_file = "error_vs_time.svg";
+static constexpr const char* summary_file = "summary.md";
+
 void write_comparison(const compare_data& data, const compare_params& p, const image_data& reference) {
   for (const compare_sampler& s : data.samplers) {
     if (s.image.pixels.empty()) continue;
-    write_image(out_path(p, std::string(sampler_name(s.kind)) + ".exr"), s.image);
-    write_error_image(out_path(p, std::string(sampler_name(s.kind)) + "_error.png"), s.image, reference, p.error_image);
+    write_image(image_file(p, s.kind), s.image);
+    write_error_image(error_file(p, s.kind), s.image, reference, p.error_image);
   }
-  write_file_atomic(out_path(p, "curves.csv"), comparison_csv(data));
-  write_file_atomic(out_path(p, "error_vs_time.svg"), comparison_svg(data, p));
-  write_file_atomic(out_path(p, "summary.md"), comparison_summary(data, p));
+  write_file_atomic(out_path(p, curves_file), comparison_csv(data));
+  write_file_atomic(out_path(p, plot_file), comparison_svg(data, p));
+  write_file_atomic(out_path(p, summary_file), comparison_summary(data, p));
 }
 
 // Creates the output directory when missing (its parent must exist); throws output_error when it cannot be
@@ -278,10 +289,11 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
     std::vector<std::pair<std::string, std::string>> outs, ins = {{params.scene_path, "scene file"},
                                                                   {params.reference_path, "reference"}};
     for (const std::string& src : scene.mesh.source_files) ins.push_back({src, "scene input"});
-    for (sampler_kind k : params.samplers)
-      for (const char* suffix : {".exr", "_error.png"})
-        outs.push_back({out_path(params, std::string(sampler_name(k)) + suffix), "output"});
-    for (const char* f : {"curves.csv", "error_vs_time.svg", "summary.md"}) outs.push_back({out_path(params, f), "output"});
+    for (sampler_kind k : params.samplers) {
+      outs.push_back({image_file(params, k), "output"});
+      outs.push_back({error_file(params, k), "output"});
+    }
+    for (const char* f : {curves_file, plot_file, summary_file}) outs.push_back({out_path(params, f), "output"});
     check_distinct_outputs(outs, ins);
   }
   bvh_data bvh = build_bvh(scene);
