@@ -122,14 +122,14 @@ hit_info intersect_triangle(const scene_data& s, int tri, vec3f org, vec3f dir) 
   return h;
 }
 
-hit_info intersect(const bvh_data& b, vec3f org, vec3f dir, float tmax) {
+hit_info intersect(const bvh_data& b, vec3f org, vec3f dir, float tmax, float tnear) {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh;
   rh.ray.org_x = org.x;
   rh.ray.org_y = org.y;
   rh.ray.org_z = org.z;
-  rh.ray.tnear = 0;
+  rh.ray.tnear = tnear;
   rh.ray.dir_x = dir.x;
   rh.ray.dir_y = dir.y;
   rh.ray.dir_z = dir.z;

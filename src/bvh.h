@@ -33,8 +33,8 @@ struct hit_info {
   float t = 0, b1 = 0, b2 = 0;
 };
 
-// Closest hit of the ray org + t*dir, t in (0, tmax); tri == invalid_id on a miss.
-hit_info intersect(const bvh_data& bvh, vec3f org, vec3f dir, float tmax = inf_f);
+// Closest hit of the ray org + t*dir, t in (tnear, tmax); tri == invalid_id on a miss.
+hit_info intersect(const bvh_data& bvh, vec3f org, vec3f dir, float tmax = inf_f, float tnear = 0);
 // Whether anything blocks the segment org + t*dir, t in (0, tmax).
 bool occluded(const bvh_data& bvh, vec3f org, vec3f dir, float tmax);
 

@@ -106,9 +106,18 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
   vec3f radiance = {0, 0, 0}, beta = {1, 1, 1};
   bool prev_mis = false;           // the current ray was BSDF-sampled at a vertex that also ran weighted NEE
   float prev_bsdf_pdf = 0;
+  float tnear = 0;                 // a continuation ray starts on its surface, and counts hits from here on
+  int from_tri = invalid_id;       // the triangle it leaves, and its point and normal
+  vec3f from_p, from_ng;
   for (int depth = 1;; depth++) {
     if (depth > 1) t0 = tm.start();
-    hit_info h = intersect(*in.bvh, org, dir);
+    hit_info h = intersect(*in.bvh, org, dir, inf_f, tnear);
+    if (h.tri != invalid_id && h.tri == from_tri) {
+      // A flat triangle cannot see itself: rounding at a grazing angle put the origin under it. Again from the
+      // full offset.
+      org = offset_ray_origin(scene, from_p, from_ng, dir);
+      h = intersect(*in.bvh, org, dir);
+    }
     tm.stop(depth == 1 ? prof_camera : prof_bounce, t0);
     t0 = tm.start();
     if (h.tri == invalid_id) {
@@ -224,8 +233,14 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     if (!go_on) break;
     prev_mis = true;
     prev_bsdf_pdf = bs.pdf;
-    org = offset_ray_origin(scene, sp.p, sp.ng, bs.wi);
+    // From the point itself (an origin moved toward a lamp a few offsets away would see it under a larger solid
+    // angle, and one moved past it would miss it), counting hits from where the ray is min_ray_epsilon above the
+    // surface (for |cos| >= 1e-3): far enough for rounding, close enough not to step over a lamp just above the
+    // surface. The check above catches a ray that still finds its own triangle.
+    org = sp.p;
+    tnear = min_ray_epsilon(scene, sp.p) / std::max(std::fabs(dot(sp.ng, bs.wi)), 1e-3f);
     dir = bs.wi;
+    from_tri = h.tri, from_p = sp.p, from_ng = sp.ng;
     st.bounce_rays++;
   }
   if (!is_finite(radiance)) {

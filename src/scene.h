@@ -63,12 +63,15 @@ inline vec3f offset_along(vec3f p, vec3f n, vec3f d, float eps) {
 inline vec3f offset_ray_origin(const scene_data& scene, vec3f p, vec3f n, vec3f d) {
   return offset_along(p, n, d, ray_epsilon(scene, p));
 }
+// The least offset off a surface: 1/20 of ray_epsilon (8 to 17 float ulps of p's largest coordinate: what the hit
+// point's rounding needs).
+inline float min_ray_epsilon(const scene_data& scene, vec3f p) { return 0.05f * ray_epsilon(scene, p); }
 // The offset of one end p of a segment to q: ray_epsilon, but at most a quarter of q's height above p's surface
 // (a lamp closer to a surface than the offset would otherwise have the segment start beyond it, or end behind the
-// surface), and at least 1/20 of ray_epsilon (about 16 float ulps of p: what the hit point's rounding needs).
+// surface), and at least min_ray_epsilon.
 inline float segment_epsilon(const scene_data& scene, vec3f p, vec3f n, vec3f q) {
   float eps = ray_epsilon(scene, p);
-  return std::max(std::min(eps, 0.25f * std::fabs(dot(n, q - p))), 0.05f * eps);
+  return std::max(std::min(eps, 0.25f * std::fabs(dot(n, q - p))), min_ray_epsilon(scene, p));
 }
 
 }  // namespace bl

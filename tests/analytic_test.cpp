@@ -121,7 +121,8 @@ TEST_CASE("a lamp just above a floor far from the origin gives the closed form i
   // 1000): the gap is half the default ray offset there (2e-5 x 1000), which a shadow ray must not step over.
   const vec3f c = {1000, 1000, 1000};
   const float a = 0.02f, h = 0.01f, le = 2.0f, rho = 0.5f;
-  for (sampler_kind kind : {sampler_kind::uniform, sampler_kind::bound, sampler_kind::bayes}) {
+  for (sampler_kind kind : {sampler_kind::uniform, sampler_kind::bound, sampler_kind::bayes})
+    for (int depth : {1, 2}) {
     mesh_builder b;
     int floor = b.add_material({rho, rho, rho});
     int lamp = b.add_material({0, 0, 0}, {le, le, le});
@@ -136,8 +137,8 @@ TEST_CASE("a lamp just above a floor far from the origin gives the closed form i
     cam.target = c;
     cam.up = {0, 0, -1};
     cam.fov_y_deg = 0.5f;
-    INFO("sampler " << sampler_name(kind));
-    check_estimate(render_pixels(b.mesh, cam, {}, false, kind, 1, 1024), exact);
+    INFO("sampler " << sampler_name(kind) << " depth " << depth);
+    check_estimate(render_pixels(b.mesh, cam, {}, false, kind, depth, 1024), exact);
   }
 }
 
