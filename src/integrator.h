@@ -62,18 +62,18 @@ struct null_sink {
   void record(const E&) {}
 };
 
-// The shadow ray of light sample ls at sp: between both points, each moved off its own surface (so neither the
-// receiver nor the emitter itself can block it, even at grazing angles), by no more than a quarter of the other
-// end's height above it (segment_epsilon: a lamp just above a floor stays lit); toward the sun, unbounded. tmax = 0
+// The shadow ray of light sample ls at sp: between both points, each moved off its own surface by min_ray_epsilon
+// (so neither the receiver nor the emitter itself can block it, even at grazing angles, while a lamp just above a
+// floor stays lit and a thin occluder beside the point still casts its shadow); toward the sun, unbounded. tmax = 0
 // when both ends coincide (nothing can block the sample).
 struct shadow_ray {
   vec3f org, dir;
   float tmax = 0;
 };
 inline shadow_ray shadow_ray_of(const scene_data& scene, const surface_point& sp, const light_sample& ls) {
-  if (ls.dist == inf_f) return {offset_ray_origin(scene, sp.p, sp.ng, ls.wi), ls.wi, inf_f};
-  vec3f o = offset_along(sp.p, sp.ng, ls.wi, segment_epsilon(scene, sp.p, sp.ng, ls.p));
-  vec3f target = offset_along(ls.p, ls.n, -ls.wi, segment_epsilon(scene, ls.p, ls.n, sp.p));
+  vec3f o = offset_along(sp.p, sp.ng, ls.wi, min_ray_epsilon(scene, sp.p));
+  if (ls.dist == inf_f) return {o, ls.wi, inf_f};
+  vec3f target = offset_along(ls.p, ls.n, -ls.wi, min_ray_epsilon(scene, ls.p));
   vec3f d = target - o;
   float t = length(d);
   if (!(t > 0)) return {o, ls.wi, 0.0f};

@@ -56,7 +56,7 @@ bool alpha_hole(const scene_data& scene, int tri, float b1, float b2);
 inline float ray_epsilon(const scene_data& scene, vec3f p) {
   return 2e-5f * std::max(max_abs_component(p), 0.05f * scene.scale);
 }
-// p moved off its surface along the normal n toward the side of direction d, by eps (default ray_epsilon).
+// p moved off its surface along the normal n toward the side of direction d, by eps.
 inline vec3f offset_along(vec3f p, vec3f n, vec3f d, float eps) {
   return dot(n, d) >= 0 ? p + n * eps : p - n * eps;
 }
@@ -64,14 +64,8 @@ inline vec3f offset_ray_origin(const scene_data& scene, vec3f p, vec3f n, vec3f 
   return offset_along(p, n, d, ray_epsilon(scene, p));
 }
 // The least offset off a surface: 1/20 of ray_epsilon (8 to 17 float ulps of p's largest coordinate: what the hit
-// point's rounding needs).
+// point's rounding needs). Rays start this far off (shadow rays) or count hits from this height on (continuation
+// rays), so that a lamp or an occluder closer to a surface than ray_epsilon is not stepped over.
 inline float min_ray_epsilon(const scene_data& scene, vec3f p) { return 0.05f * ray_epsilon(scene, p); }
-// The offset of one end p of a segment to q: ray_epsilon, but at most a quarter of q's height above p's surface
-// (a lamp closer to a surface than the offset would otherwise have the segment start beyond it, or end behind the
-// surface), and at least min_ray_epsilon.
-inline float segment_epsilon(const scene_data& scene, vec3f p, vec3f n, vec3f q) {
-  float eps = ray_epsilon(scene, p);
-  return std::max(std::min(eps, 0.25f * std::fabs(dot(n, q - p))), min_ray_epsilon(scene, p));
-}
 
 }  // namespace bl

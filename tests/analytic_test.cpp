@@ -11,6 +11,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 using namespace bl;
 using namespace bl::test;
 
@@ -140,6 +142,41 @@ TEST_CASE("a lamp just above a floor far from the origin gives the closed form i
     INFO("sampler " << sampler_name(kind) << " depth " << depth);
     check_estimate(render_pixels(b.mesh, cam, {}, false, kind, depth, 1024), exact);
   }
+}
+
+TEST_CASE("a wall thinner than the default ray offset still shadows a point beside it far from the origin", "[analytic]") {
+  // At (1000, 1000, 1000) the default ray offset is 0.02. A wall 0.01 high stands 0.005 beside the viewed point; a
+  // lamp (or the sun) low behind it is hidden from the point: every shadow ray passes the wall at a height under
+  // 0.002 above the floor. A shadow ray started 0.02 above the floor would pass over the wall and light the point.
+  const vec3f c = {1000, 1000, 1000};
+  for (bool sun_light : {false, true})
+    for (sampler_kind kind : kinds) {
+      mesh_builder b;
+      int floor = b.add_material({0.5f, 0.5f, 0.5f});
+      int lamp = b.add_material({0, 0, 0}, {2, 2, 2});
+      b.add_quad(c + vec3f{-20, 0, -20}, c + vec3f{-20, 0, 20}, c + vec3f{20, 0, 20}, c + vec3f{20, 0, -20}, floor);
+      b.add_quad(c + vec3f{0.005f, 0, -5}, c + vec3f{0.005f, 0.01f, -5}, c + vec3f{0.005f, 0.01f, 5},
+                 c + vec3f{0.005f, 0, 5}, floor);
+      sun_params sun;
+      if (sun_light) {
+        sun.enabled = true;
+        sun.direction = normalize(vec3f{1, 0.1f, 0});
+        sun.irradiance = {3, 3, 3};
+      } else {
+        // Facing -x, toward the point, 1 away and 0.05 to 0.15 up: elevations under 9 degrees.
+        b.add_quad(c + vec3f{1, 0.05f, -0.05f}, c + vec3f{1, 0.05f, 0.05f}, c + vec3f{1, 0.15f, 0.05f},
+                   c + vec3f{1, 0.15f, -0.05f}, lamp);
+      }
+      camera_params cam;
+      cam.automatic = false;
+      cam.eye = c + vec3f{0, 0.005f, 0};
+      cam.target = c;
+      cam.up = {0, 0, -1};
+      cam.fov_y_deg = 0.5f;
+      INFO("sampler " << sampler_name(kind) << (sun_light ? " sun" : " lamp"));
+      std::vector<double> px = render_pixels(b.mesh, cam, sun, false, kind, 1, 64);
+      CHECK(*std::max_element(px.begin(), px.end()) == 0.0);
+    }
 }
 
 TEST_CASE("a furnace sphere of emitting grey walls sums its bounces", "[analytic]") {
