@@ -235,10 +235,11 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     prev_bsdf_pdf = bs.pdf;
     // From the point itself (an origin moved toward a lamp a few offsets away would see it under a larger solid
     // angle, and one moved past it would miss it), counting hits from where the ray is min_ray_epsilon above the
-    // surface (for |cos| >= 1e-3): far enough for rounding, close enough not to step over a lamp just above the
-    // surface. The check above catches a ray that still finds its own triangle.
+    // surface, or at most 2 min_ray_epsilon along it for rays within 30 degrees of the surface (a grazing ray would
+    // otherwise step over a wall next to the point): far enough for rounding, close enough not to step over a lamp
+    // just above the surface. The check above catches a ray that still finds its own triangle.
     org = sp.p;
-    tnear = min_ray_epsilon(scene, sp.p) / std::max(std::fabs(dot(sp.ng, bs.wi)), 1e-3f);
+    tnear = min_ray_epsilon(scene, sp.p) / std::max(std::fabs(dot(sp.ng, bs.wi)), 0.5f);
     dir = bs.wi;
     from_tri = h.tri, from_p = sp.p, from_ng = sp.ng;
     st.bounce_rays++;

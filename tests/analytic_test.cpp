@@ -150,7 +150,8 @@ TEST_CASE("a wall thinner than the default ray offset still shadows a point besi
   // 0.002 above the floor. A shadow ray started 0.02 above the floor would pass over the wall and light the point.
   const vec3f c = {1000, 1000, 1000};
   for (bool sun_light : {false, true})
-    for (sampler_kind kind : kinds) {
+    for (sampler_kind kind : kinds)
+      for (int depth : {1, 2}) {
       mesh_builder b;
       int floor = b.add_material({0.5f, 0.5f, 0.5f});
       int lamp = b.add_material({0, 0, 0}, {2, 2, 2});
@@ -173,8 +174,8 @@ TEST_CASE("a wall thinner than the default ray offset still shadows a point besi
       cam.target = c;
       cam.up = {0, 0, -1};
       cam.fov_y_deg = 0.5f;
-      INFO("sampler " << sampler_name(kind) << (sun_light ? " sun" : " lamp"));
-      std::vector<double> px = render_pixels(b.mesh, cam, sun, false, kind, 1, 64);
+      INFO("sampler " << sampler_name(kind) << (sun_light ? " sun" : " lamp") << " depth " << depth);
+      std::vector<double> px = render_pixels(b.mesh, cam, sun, false, kind, depth, 64);
       CHECK(*std::max_element(px.begin(), px.end()) == 0.0);
     }
 }
