@@ -120,7 +120,8 @@ TEST_CASE("the holes of an emitter's own map_d emit nothing", "[analytic]") {
 
 TEST_CASE("a lamp just above a floor far from the origin gives the closed form irradiance", "[analytic]") {
   // The square lamp of the test above at 1/50 of its size, 0.01 above the floor, everything moved to (1000, 1000,
-  // 1000): the gap is half the default ray offset there (2e-5 x 1000), which a shadow ray must not step over.
+  // 1000): the gap is half the default ray offset there (2e-5 x 1000), which neither a shadow ray nor (path traced,
+  // under MIS) a BSDF continuation ray may step over, and which a continuation ray must see from the point itself.
   const vec3f c = {1000, 1000, 1000};
   const float a = 0.02f, h = 0.01f, le = 2.0f, rho = 0.5f;
   for (sampler_kind kind : {sampler_kind::uniform, sampler_kind::bound, sampler_kind::bayes})
