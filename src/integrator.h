@@ -85,6 +85,23 @@ inline bool unoccluded(const render_inputs& in, const surface_point& sp, const l
   return !(r.tmax > 0) || !occluded(*in.bvh, r.org, r.dir, r.tmax);
 }
 
+// The closest hit of a BSDF continuation ray leaving triangle `tri` at its point p (geometric normal ng) in
+// direction d. From p itself (an origin moved toward a lamp a few offsets away would see it under a larger solid
+// angle, and one moved past it would miss it), counting hits from where the ray is min_ray_epsilon above the
+// surface, or at most 2 min_ray_epsilon along it for rays within 30 degrees of the surface (a grazing ray would
+// otherwise step over a wall next to the point): far enough for rounding, close enough not to step over a lamp just
+// above the surface. A flat triangle cannot see itself: a hit on `tri` (rounding put p under its plane and the ray
+// is grazing) is traced again from the ray_epsilon offset. hit.t is measured from the origin used.
+// continuation_tnear: where along the ray hits start to count.
+inline float continuation_tnear(const scene_data& scene, vec3f p, vec3f ng, vec3f d) {
+  return min_ray_epsilon(scene, p) / std::max(std::fabs(dot(ng, d)), 0.5f);
+}
+inline hit_info continuation_hit(const render_inputs& in, int tri, vec3f p, vec3f ng, vec3f d) {
+  hit_info h = intersect(*in.bvh, p, d, inf_f, continuation_tnear(*in.scene, p, ng, d));
+  if (h.tri == invalid_id || h.tri != tri) return h;
+  return intersect(*in.bvh, offset_ray_origin(*in.scene, p, ng, d), d);
+}
+
 // Radiance of sample `sample` of pixel (x, y). `ctxs` are the light-selection contexts of the current and the
 // previous vertex (alternating by depth); the caller keeps them across samples of a row, so that samplers can
 // reuse per-point work between neighbouring samples (e.g. a region lookup). `tm` times the hot path's stages
@@ -106,18 +123,11 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
   vec3f radiance = {0, 0, 0}, beta = {1, 1, 1};
   bool prev_mis = false;           // the current ray was BSDF-sampled at a vertex that also ran weighted NEE
   float prev_bsdf_pdf = 0;
-  float tnear = 0;                 // a continuation ray starts on its surface, and counts hits from here on
-  int from_tri = invalid_id;       // the triangle it leaves, and its point and normal
-  vec3f from_p, from_ng;
+  int from_tri = invalid_id;       // a continuation ray: the triangle it leaves, and its normal (org is its point)
+  vec3f from_ng;
   for (int depth = 1;; depth++) {
     if (depth > 1) t0 = tm.start();
-    hit_info h = intersect(*in.bvh, org, dir, inf_f, tnear);
-    if (h.tri != invalid_id && h.tri == from_tri) {
-      // A flat triangle cannot see itself: rounding at a grazing angle put the origin under it. Again from the
-      // full offset.
-      org = offset_ray_origin(scene, from_p, from_ng, dir);
-      h = intersect(*in.bvh, org, dir);
-    }
+    hit_info h = depth == 1 ? intersect(*in.bvh, org, dir) : continuation_hit(in, from_tri, org, from_ng, dir);
     tm.stop(depth == 1 ? prof_camera : prof_bounce, t0);
     t0 = tm.start();
     if (h.tri == invalid_id) {
@@ -233,15 +243,9 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     if (!go_on) break;
     prev_mis = true;
     prev_bsdf_pdf = bs.pdf;
-    // From the point itself (an origin moved toward a lamp a few offsets away would see it under a larger solid
-    // angle, and one moved past it would miss it), counting hits from where the ray is min_ray_epsilon above the
-    // surface, or at most 2 min_ray_epsilon along it for rays within 30 degrees of the surface (a grazing ray would
-    // otherwise step over a wall next to the point): far enough for rounding, close enough not to step over a lamp
-    // just above the surface. The check above catches a ray that still finds its own triangle.
-    org = sp.p;
-    tnear = min_ray_epsilon(scene, sp.p) / std::max(std::fabs(dot(sp.ng, bs.wi)), 0.5f);
+    org = sp.p;  // continuation_hit starts the ray at the point itself
     dir = bs.wi;
-    from_tri = h.tri, from_p = sp.p, from_ng = sp.ng;
+    from_tri = h.tri, from_ng = sp.ng;
     st.bounce_rays++;
   }
   if (!is_finite(radiance)) {
