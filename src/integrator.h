@@ -90,16 +90,25 @@ inline bool unoccluded(const render_inputs& in, const surface_point& sp, const l
 // angle, and one moved past it would miss it), counting hits from where the ray is min_ray_epsilon above the
 // surface, or at most 2 min_ray_epsilon along it for rays within 30 degrees of the surface (a grazing ray would
 // otherwise step over a wall next to the point): far enough for rounding, close enough not to step over a lamp just
-// above the surface. A flat triangle cannot see itself: a hit on `tri` (rounding put p under its plane and the ray
-// is grazing) is traced again from the ray_epsilon offset. hit.t is measured from the origin used.
+// above the surface. A ray leaving a plane cannot hit that plane again, but p lies a few ulps off it, and a grazing
+// ray can cross it (the triangle left or a coplanar neighbour, at any distance): a hit on `tri`, or on a triangle
+// parallel to it whose plane passes within min_ray_epsilon of p, is traced again from the ray_epsilon offset.
+// hit.t is measured from the origin used.
 // continuation_tnear: where along the ray hits start to count.
 inline float continuation_tnear(const scene_data& scene, vec3f p, vec3f ng, vec3f d) {
   return min_ray_epsilon(scene, p) / std::max(std::fabs(dot(ng, d)), 0.5f);
 }
 inline hit_info continuation_hit(const render_inputs& in, int tri, vec3f p, vec3f ng, vec3f d) {
-  hit_info h = intersect(*in.bvh, p, d, inf_f, continuation_tnear(*in.scene, p, ng, d));
-  if (h.tri == invalid_id || h.tri != tri) return h;
-  return intersect(*in.bvh, offset_ray_origin(*in.scene, p, ng, d), d);
+  const scene_data& scene = *in.scene;
+  hit_info h = intersect(*in.bvh, p, d, inf_f, continuation_tnear(scene, p, ng, d));
+  if (h.tri == invalid_id) return h;
+  if (h.tri != tri) {
+    vec3f n = scene.tri_ng[size_t(h.tri)];
+    bool same_plane = std::fabs(dot(n, ng)) > 0.9999f &&
+                      std::fabs(dot(n, p - scene.tri_p0[size_t(h.tri)])) <= min_ray_epsilon(scene, p);
+    if (!same_plane) return h;
+  }
+  return intersect(*in.bvh, offset_ray_origin(scene, p, ng, d), d);
 }
 
 // Radiance of sample `sample` of pixel (x, y). `ctxs` are the light-selection contexts of the current and the
