@@ -92,7 +92,7 @@ inline bool unoccluded(const render_inputs& in, const surface_point& sp, const l
 // otherwise step over a wall next to the point): far enough for rounding, close enough not to step over a lamp just
 // above the surface. A ray leaving a plane cannot hit that plane again, but p lies a few ulps off it, and a grazing
 // ray can cross it (the triangle left or a coplanar neighbour, at any distance): a hit on `tri`, or on a triangle
-// parallel to it whose plane passes within min_ray_epsilon of p, is traced again from the ray_epsilon offset.
+// parallel to it whose plane passes within rounding of p, is traced again from the ray_epsilon offset.
 // hit.t is measured from the origin used.
 // continuation_tnear: where along the ray hits start to count.
 inline float continuation_tnear(const scene_data& scene, vec3f p, vec3f ng, vec3f d) {
@@ -103,9 +103,11 @@ inline hit_info continuation_hit(const render_inputs& in, int tri, vec3f p, vec3
   hit_info h = intersect(*in.bvh, p, d, inf_f, continuation_tnear(scene, p, ng, d));
   if (h.tri == invalid_id) return h;
   if (h.tri != tri) {
-    vec3f n = scene.tri_ng[size_t(h.tri)];
+    // The plane distance in float errs by a few ulps of |p - corner|, which for a large triangle can exceed
+    // min_ray_epsilon at p: the tolerance takes 1e-6 of that length on top (about 8 ulps).
+    vec3f n = scene.tri_ng[size_t(h.tri)], v = p - scene.tri_p0[size_t(h.tri)];
     bool same_plane = std::fabs(dot(n, ng)) > 0.9999f &&
-                      std::fabs(dot(n, p - scene.tri_p0[size_t(h.tri)])) <= min_ray_epsilon(scene, p);
+                      std::fabs(dot(n, v)) <= min_ray_epsilon(scene, p) + 1e-6f * max_abs_component(v);
     if (!same_plane) return h;
   }
   return intersect(*in.bvh, offset_ray_origin(scene, p, ng, d), d);

@@ -244,44 +244,54 @@ TEST_CASE("a sliver emitter of area 1e-10 renders consistently with every sample
 
 
 TEST_CASE("a grazing continuation ray hits neither the triangle it leaves nor a coplanar neighbour", "[stiff]") {
-  // A large tilted quad (two coplanar triangles) far from the origin: its points, interpolated in float as hits are,
-  // lie a few ulps off its plane, and a ray leaving one almost parallel to the plane can cross it again beyond tnear,
-  // in the triangle it leaves or in the other one. Nothing else is in the scene, so every hit is such a crossing.
-  // continuation_hit traces those again from the ray_epsilon offset; the raw query with the same tnear shows that
-  // both kinds occur.
-  mesh_builder mb;
-  int grey = mb.add_material({0.5f, 0.5f, 0.5f});
-  const vec3f c = {10000, 10000, 10000};
-  const vec3f a = c + vec3f{-50, -13, -40}, b1 = c + vec3f{60, 7, -30}, b2 = c + vec3f{-10, 21, 70};
-  mb.add_triangle(a, b1, b2, grey);
-  mb.add_triangle(b1, b1 + b2 - a, b2, grey);
-  camera_params cam;
-  auto b = build(std::move(mb.mesh), cam);
-  render_inputs in;
-  in.scene = &b->scene;
-  in.bvh = &b->bvh;
-  pcg32 rng(17, 3);
-  auto unit = [&] { return double(rng()) * 0x1p-32; };
-  int raw_self = 0, raw_other = 0, hits = 0;
-  const int rays = 100000;
-  for (int i = 0; i < rays; i++) {
-    int tri = i & 1;
-    float u1 = float(unit()), u2 = float(unit());
-    if (u1 + u2 > 1) u1 = 1 - u1, u2 = 1 - u2;
-    surface_point sp = eval_surface(b->scene, tri, u1, u2, -b->scene.tri_ng[size_t(tri)]);
-    // A direction 1e-8 to 1e-2 radians above the surface, in a random tangent direction.
-    vec3f t = normalize(cross(sp.ng, std::fabs(sp.ng.x) < 0.9f ? vec3f{1, 0, 0} : vec3f{0, 1, 0}));
-    vec3f u = cross(sp.ng, t);
-    double phi = 2 * M_PI * unit(), lift = std::pow(10.0, -8 + 6 * unit());
-    vec3f d = normalize(t * float(std::cos(phi)) + u * float(std::sin(phi)) + sp.ng * float(lift));
-    int raw = intersect(b->bvh, sp.p, d, inf_f, continuation_tnear(b->scene, sp.p, sp.ng, d)).tri;
-    raw_self += raw == tri;
-    raw_other += raw == 1 - tri;
-    hits += continuation_hit(in, tri, sp.p, sp.ng, d).tri != invalid_id;
+  // A large tilted quad (two coplanar triangles), far from the origin (points anywhere on it) or twice as large
+  // with its diagonal's midpoint at the origin (points near that midpoint, where the plane distance to the other
+  // triangle's far corner errs by more than min_ray_epsilon at the point): its points, interpolated in float as hits
+  // are, lie a few ulps off its plane, and a ray leaving one almost parallel to the plane can cross it again beyond
+  // tnear, in the triangle it leaves or in the other one. Nothing else is in the scene, so every hit is such a
+  // crossing. continuation_hit traces those again from the ray_epsilon offset; the raw query with the same tnear
+  // shows that both kinds occur.
+  const vec3f a0 = {-50, -13, -40}, b10 = {60, 7, -30}, b20 = {-10, 21, 70};
+  for (bool centred : {false, true}) {
+    mesh_builder mb;
+    int grey = mb.add_material({0.5f, 0.5f, 0.5f});
+    const float k = centred ? 2.0f : 1.0f;
+    const vec3f shift = centred ? (b10 + b20) * -1.0f : vec3f{10000, 10000, 10000};
+    const vec3f a = a0 * k + shift, b1 = b10 * k + shift, b2 = b20 * k + shift;
+    mb.add_triangle(a, b1, b2, grey);
+    mb.add_triangle(b1, b1 + b2 - a, b2, grey);
+    camera_params cam;
+    auto b = build(std::move(mb.mesh), cam);
+    render_inputs in;
+    in.scene = &b->scene;
+    in.bvh = &b->bvh;
+    pcg32 rng(17, 3);
+    auto unit = [&] { return double(rng()) * 0x1p-32; };
+    int raw_self = 0, raw_other = 0, hits = 0;
+    const int rays = 100000;
+    for (int i = 0; i < rays; i++) {
+      int tri = i & 1;
+      float u1 = float(unit()), u2 = float(unit());
+      if (u1 + u2 > 1) u1 = 1 - u1, u2 = 1 - u2;
+      if (centred) {  // within 1 % of the diagonal's midpoint (u1 = u2 = 1/2 of triangle 0, u1 = 0, u2 = 1/2 of 1)
+        u2 = float(0.5 - 0.01 * unit());
+        u1 = tri == 0 ? float(0.5 + 0.01 * (unit() - 0.5)) : float(0.01 * unit());
+      }
+      surface_point sp = eval_surface(b->scene, tri, u1, u2, -b->scene.tri_ng[size_t(tri)]);
+      // A direction 1e-8 to 1e-2 radians above the surface, in a random tangent direction.
+      vec3f t = normalize(cross(sp.ng, std::fabs(sp.ng.x) < 0.9f ? vec3f{1, 0, 0} : vec3f{0, 1, 0}));
+      vec3f u = cross(sp.ng, t);
+      double phi = 2 * M_PI * unit(), lift = std::pow(10.0, -8 + 6 * unit());
+      vec3f d = normalize(t * float(std::cos(phi)) + u * float(std::sin(phi)) + sp.ng * float(lift));
+      int raw = intersect(b->bvh, sp.p, d, inf_f, continuation_tnear(b->scene, sp.p, sp.ng, d)).tri;
+      raw_self += raw == tri;
+      raw_other += raw == 1 - tri;
+      hits += continuation_hit(in, tri, sp.p, sp.ng, d).tri != invalid_id;
+    }
+    INFO((centred ? "centred" : "far") << ": raw queries: " << raw_self << " of " << rays << " hit the triangle they leave, "
+                  << raw_other << " the coplanar one; continuation_hit " << hits);
+    CHECK(raw_self > 0);
+    CHECK(raw_other > 0);
+    CHECK(hits == 0);
   }
-  INFO("raw queries: " << raw_self << " of " << rays << " hit the triangle they leave, " << raw_other
-                       << " the coplanar one");
-  CHECK(raw_self > 0);
-  CHECK(raw_other > 0);
-  CHECK(hits == 0);
 }
