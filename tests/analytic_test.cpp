@@ -148,7 +148,8 @@ TEST_CASE("a lamp just above a floor far from the origin gives the closed form i
 TEST_CASE("a wall thinner than the default ray offset still shadows a point beside it far from the origin", "[analytic]") {
   // At (1000, 1000, 1000) the default ray offset is 0.02. A wall 0.01 high stands 0.005 beside the viewed point; a
   // lamp (or the sun) low behind it is hidden from the point: every shadow ray passes the wall at a height under
-  // 0.002 above the floor. A shadow ray started 0.02 above the floor would pass over the wall and light the point.
+  // 0.002 above the floor. A shadow ray started 0.02 above the floor would pass over the wall and light the point;
+  // path traced (depth 2), a BSDF ray toward the lamp that skipped its first 0.005 would pass through the wall.
   const vec3f c = {1000, 1000, 1000};
   for (bool sun_light : {false, true})
     for (sampler_kind kind : kinds)
