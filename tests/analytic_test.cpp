@@ -48,12 +48,12 @@ void check_estimate(const std::vector<double>& px, double exact) {
   CHECK(std::fabs(m.mean - exact) < z_crit * m.se);
 }
 
-// A camera at height `h` looking straight down at the origin with a narrow field of view.
-camera_params looking_down(float h) {
+// A camera at height `h` above `at` (default: the origin) looking straight down at it with a narrow field of view.
+camera_params looking_down(float h, vec3f at = {0, 0, 0}) {
   camera_params c;
   c.automatic = false;
-  c.eye = {0, h, 0};
-  c.target = {0, 0, 0};
+  c.eye = at + vec3f{0, h, 0};
+  c.target = at;
   c.up = {0, 0, -1};
   c.fov_y_deg = 0.5f;
   return c;
@@ -134,14 +134,8 @@ TEST_CASE("a lamp just above a floor far from the origin gives the closed form i
     // The closed form for the geometry as stored (float coordinates near 1000 are 6e-5 apart).
     double hs = double(c.y + h) - double(c.y), as = double(c.x + a) - double(c.x);
     double exact = under_square_lamp(as, hs, le, rho);
-    camera_params cam;
-    cam.automatic = false;
-    cam.eye = c + vec3f{0, 0.005f, 0};
-    cam.target = c;
-    cam.up = {0, 0, -1};
-    cam.fov_y_deg = 0.5f;
     INFO("sampler " << sampler_name(kind) << " depth " << depth);
-    check_estimate(render_pixels(b.mesh, cam, {}, false, kind, depth, 1024), exact);
+    check_estimate(render_pixels(b.mesh, looking_down(0.005f, c), {}, false, kind, depth, 1024), exact);
   }
 }
 
@@ -170,14 +164,8 @@ TEST_CASE("a wall thinner than the default ray offset still shadows a point besi
         b.add_quad(c + vec3f{1, 0.05f, -0.05f}, c + vec3f{1, 0.05f, 0.05f}, c + vec3f{1, 0.15f, 0.05f},
                    c + vec3f{1, 0.15f, -0.05f}, lamp);
       }
-      camera_params cam;
-      cam.automatic = false;
-      cam.eye = c + vec3f{0, 0.005f, 0};
-      cam.target = c;
-      cam.up = {0, 0, -1};
-      cam.fov_y_deg = 0.5f;
       INFO("sampler " << sampler_name(kind) << (sun_light ? " sun" : " lamp") << " depth " << depth);
-      std::vector<double> px = render_pixels(b.mesh, cam, sun, false, kind, depth, 64);
+      std::vector<double> px = render_pixels(b.mesh, looking_down(0.005f, c), sun, false, kind, depth, 64);
       CHECK(*std::max_element(px.begin(), px.end()) == 0.0);
     }
 }
