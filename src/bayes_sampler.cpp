@@ -2,8 +2,10 @@
 #include "bayes_sampler.h"
 
 #include "cluster_bounds.h"
+#include "sampling.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <xmmintrin.h>
 
@@ -22,14 +24,26 @@ double point_scale(float albedo) { return double((albedo > 0 ? albedo : 1.0f) * 
 // Least receiver cosine factor of a cluster the front test keeps (it stays possible, and z = Y / factor bounded).
 constexpr float orientation_floor = 1e-3f;
 
+// The total weight of members [b, e) of a cluster, each positive weight floored at min_positive_share of their raw
+// sum (as fill_cdf does: no member that can contribute rounds to probability zero); `floor` receives that floor.
+double members_total(const float* w, int b, int e, double& floor) {
+  double raw = 0;
+  for (int k = b; k < e; k++) raw += double(w[k]);
+  floor = raw * min_positive_share;
+  double total = 0;
+  for (int k = b; k < e; k++)
+    if (w[k] > 0) total += std::max(double(w[k]), floor);
+  return total;
+}
+
 }  // namespace
 
 void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   ctx.cv = false;
   if (fallback) return;  // power sampling: no region, no weights
   locate_region(ctx, regions, sp);
-  if (ctx.count == 1) {
-    // One cluster: its probability is 1 whatever was learned (and nothing is recorded for it).
+  if (ctx.pair_count == 1) {
+    // One cluster of one member: its probability is 1 whatever was learned (and nothing is recorded for it).
     ctx.cdf[0] = 0;
     ctx.cdf[1] = 1;
     return;
@@ -96,10 +110,31 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   // bounding sphere lies entirely behind the surface: dot(n, p - c_j) >= r_j (plus a rounding slack), where no
   // light of it can give a non-zero sample (the BSDF is zero below the geometric tangent plane). Four tree
   // clusters at a time; the sun (last, if any) is zero when its whole disk is below the tangent plane.
+  // With members (a cluster of several), a cluster weighs the sum of its members' W (gw, gw_cv) and c_j of its
+  // members at the point is their cv times the cluster's factor g; the member is chosen in sample_members.
   size_t base = size_t(ctx.pair_base);
   ctx.cv = params.control_variate && sp.last;
-  const float* W = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
+  const bool grouped = ctx.pair_count != ctx.count;
+  ctx.member_w = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
+  const float* W = grouped ? (ctx.cv ? stats.gw_cv.data() : stats.gw.data()) + ctx.group_base : ctx.member_w;
+  const float* cvj = grouped ? stats.gcv.data() + ctx.group_base : stats.cv.data() + base;
   const float* mu0 = stats.mu0.data() + base;
+  // The prior model's weight of cluster j at g = 1: the sum of its members' mu0.
+  auto cluster_mu0 = [&](int j) {
+    if (!grouped) return double(mu0[j]);
+    int e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
+    double m = 0;
+    for (int k = ctx.member_begin[j]; k < e; k++) m += double(mu0[k]);
+    return m;
+  };
+  // Adds colour_m c_m of cluster j's members (c_m = cv_m g_j) to cv_sum, in member order.
+  auto add_members_cv = [&](vec3f& sum, int j, float g) {
+    int e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
+    for (int k = ctx.member_begin[j]; k < e; k++) {
+      float c = stats.cv[base + size_t(k)] * g;
+      if (c != 0) sum += cluster_color(ctx, k) * c;
+    }
+  };
   alignas(16) float wf[max_cut_entries + 3];
   float* gf = ctx.gfac;
   const int tc = ctx.tree_count;
@@ -141,11 +176,12 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     if (ctx.cv) {
       // c_j = (E[1 - p0] k_j) g_j, zero behind the surface like the weight, and their colour-weighted sum in
       // cluster order (most pairs have no control variate: c_j = 0, skipped four at a time).
-      __m128 c = _mm_mul_ps(_mm_loadu_ps(stats.cv.data() + base + size_t(j0)), g);
+      __m128 c = _mm_mul_ps(_mm_loadu_ps(cvj + j0), g);
       _mm_storeu_ps(ctx.cvg + j0, c);
       for (int m = _mm_movemask_ps(_mm_cmpneq_ps(c, zero)) & lanes; m != 0; m &= m - 1) {
         int j = j0 + __builtin_ctz(unsigned(m));
-        cv_sum += cluster_color(ctx, j) * ctx.cvg[j];
+        if (grouped) add_members_cv(cv_sum, j, gf[j]);
+        else cv_sum += cluster_color(ctx, j) * ctx.cvg[j];
       }
     }
   }
@@ -156,8 +192,9 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     wf[tc] = W[tc] * gf[tc];
     front_mask |= gf[tc] > 0;
     if (ctx.cv) {
-      ctx.cvg[tc] = stats.cv[base + size_t(tc)] * gf[tc];
-      if (ctx.cvg[tc] != 0) cv_sum += cluster_color(ctx, tc) * ctx.cvg[tc];
+      int sun_member = ctx.pair_count - 1;  // the sun: its cluster's only member, the last
+      ctx.cvg[tc] = stats.cv[base + size_t(sun_member)] * gf[tc];
+      if (ctx.cvg[tc] != 0) cv_sum += cluster_color(ctx, sun_member) * ctx.cvg[tc];
     }
   }
   ctx.cv_sum = cv_sum;
@@ -177,13 +214,14 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   double eps = params.prior ? params.epsilon : std::max(params.epsilon, 1e-3);
   if (eps > 0) {
     double sum_w = 0, sum_b = 0;
-    for (int j = 0; j < ctx.count; j++) sum_w += w[j], sum_b += double(mu0[j]) * gf[j];
+    for (int j = 0; j < ctx.count; j++) sum_w += w[j], sum_b += cluster_mu0(j) * gf[j];
     if (sum_w > 0 && sum_b > 0)
-      for (int j = 0; j < ctx.count; j++) w[j] = (1 - eps) * w[j] / sum_w + eps * double(mu0[j]) * gf[j] / sum_b;
+      for (int j = 0; j < ctx.count; j++) w[j] = (1 - eps) * w[j] / sum_w + eps * cluster_mu0(j) * gf[j] / sum_b;
   }
   if (finish_cdf(ctx, w)) return;
-  // Overflowing weights (absurd radiance scales) fall back to the prior model, then to every cluster in front.
-  for (int j = 0; j < ctx.count; j++) w[j] = double(mu0[j]) * gf[j];
+  // Overflowing weights (absurd radiance scales) fall back to the prior model, then to every cluster in front (the
+  // members then still follow their weights).
+  for (int j = 0; j < ctx.count; j++) w[j] = cluster_mu0(j) * gf[j];
   if (finish_cdf(ctx, w)) return;
   for (int j = 0; j < ctx.count; j++) w[j] = gf[j] > 0 ? 1.0 : 0.0;
   finish_cdf(ctx, w);
@@ -202,13 +240,14 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   }
   const cut_context& ctx = *e.context;
   row.requests.add(ctx);
-  int j = e.choice.cluster;
-  if (j < 0 || ctx.count == 1) return;
+  int j = e.choice.cluster;  // the member
+  if (j < 0 || ctx.pair_count == 1) return;
   double z = e.value;
   if (z > 0) {
     if (params.region_prior) {
-      // The albedo-free sample (see bayes_stats) over the point factor the pmf used: z = Y d^2 / cos bound.
-      z = z / point_scale(ctx.albedo) / double(ctx.gfac[j]);
+      // The albedo-free sample (see bayes_stats) over the point factor the pmf used (its cluster's): z = Y d^2 / cos
+      // bound.
+      z = z / point_scale(ctx.albedo) / double(ctx.gfac[group_of(ctx, j)]);
     } else if (params.distance_regression) {
       double d = cluster_distance(*tree, ctx.nodes[j], ctx.p);
       z *= d * d;
@@ -220,11 +259,109 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
     ctx.rec_owner = &row;
     ctx.rec_generation = row.generation;
     ctx.rec_base = ctx.pair_base;
-    std::fill(ctx.rec_slot, ctx.rec_slot + ctx.count, -1);
+    std::fill(ctx.rec_slot, ctx.rec_slot + ctx.pair_count, -1);
   }
   int& slot = ctx.rec_slot[j];
   if (slot < 0) slot = row.slot_of(ctx.pair_base + j);
   row.add_at(slot, z);
+}
+
+light_choice bayes_sampler::sample_members(const context& ctx, double u, double u_inner) const {
+  if (ctx.count == 0 || !(ctx.cdf[ctx.count] > 0)) return {};
+  int j = sample_cdf(ctx.cdf, ctx.count, u);
+  double pj = cluster_pmf(ctx, j);
+  if (!(pj > 0)) return {};
+  int b = ctx.member_begin[j], e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
+  int m = b;
+  double p = pj;
+  if (e - b > 1) {
+    // u's place inside the cluster's cell, rescaled to the members' total weight (a cluster chosen has a positive
+    // total: its weight is that sum); members of weight 0 are never chosen.
+    const float* w = ctx.member_w;
+    double floor = 0, total = members_total(w, b, e, floor);
+    double x = (u - ctx.cdf[j]) / pj * total, run = 0;
+    m = -1;
+    for (int k = b; k < e; k++) {
+      if (!(w[k] > 0)) continue;
+      run += std::max(double(w[k]), floor);
+      m = k;
+      if (x < run) break;
+    }
+    if (m < 0) return {};
+    p = pj * (std::max(double(w[m]), floor) / total);
+  }
+  int node = ctx.members[m];
+  if (node == sun_cluster) return {lights->sun, float(p), m, 1.0f, p};
+  double inner = 1;
+  int leaf = sample_by_intensity(*tree, node, u_inner, inner);
+  return {tree->light[size_t(leaf)], float(p * inner), m, float(inner), p};
+}
+
+float bayes_sampler::members_pmf(const context& ctx, int light) const {
+  if (ctx.count == 0) return 0;
+  int m = invalid_id, leaf = invalid_id;
+  if (light == lights->sun) {
+    if (ctx.nodes[ctx.count - 1] != sun_cluster) return 0;
+    m = ctx.pair_count - 1;
+  } else {
+    leaf = tree->leaf_of_light[size_t(light)];
+    const int* begin = ctx.members;
+    const int* end = ctx.members + ctx.pair_count - (ctx.tree_count < ctx.count ? 1 : 0);
+    for (int n = leaf; n != invalid_id && m < 0; n = tree->parent[size_t(n)]) {
+      const int* it = std::lower_bound(begin, end, n);
+      if (it != end && *it == n) m = int(it - begin);
+    }
+    if (m < 0) return 0;  // the light's subtree was left out of the cut: it cannot reach this region
+  }
+  int j = group_of(ctx, m);
+  double p = cluster_pmf(ctx, j);
+  int b = ctx.member_begin[j], e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
+  if (e - b > 1) {
+    const float* w = ctx.member_w;
+    double floor = 0, total = members_total(w, b, e, floor);
+    p = total > 0 && w[m] > 0 ? p * (std::max(double(w[m]), floor) / total) : 0.0;
+  }
+  if (leaf != invalid_id) p *= intensity_descent_pmf(*tree, ctx.members[m], leaf);
+  return float(p);
+}
+
+void bayes_sampler::refresh_groups(const std::vector<int>* pairs) {
+  if (!regions.members) return;
+  size_t slots = regions.cut_nodes.size();
+  stats.gw.resize(slots + 4, 0.0f);
+  stats.gw_cv.resize(slots + 4, 0.0f);
+  stats.gcv.resize(slots + 4, 0.0f);
+  const std::vector<int>& slot = regions.pair_slot;
+  size_t npairs = slot.size();
+  // The sums of the run of pairs of one cluster starting at `first` (a cluster's members are consecutive pairs).
+  auto sum_run = [&](size_t first) {
+    int g = slot[first];
+    double a = 0, b = 0, c = 0;
+    for (size_t k = first; k < npairs && slot[k] == g; k++) a += stats.w[k], b += stats.w_cv[k], c += stats.cv[k];
+    stats.gw[size_t(g)] = float(a);
+    stats.gw_cv[size_t(g)] = float(b);
+    stats.gcv[size_t(g)] = float(c);
+  };
+  if (!pairs) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, regions.key.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); i++) {
+        size_t b = size_t(regions.pair_offset[i]), e = b + size_t(regions.pair_count[i]);
+        for (size_t k = b; k < e; k++)
+          if (k == b || slot[k] != slot[k - 1]) sum_run(k);
+      }
+    });
+    return;
+  }
+  // Each listed pair was refolded and flagged (stats.scratch.dirty); the first flagged member of a cluster sums it.
+  const std::vector<uint8_t>& dirty = stats.scratch.dirty;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs->size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t < r.end(); t++) {
+      size_t k = size_t((*pairs)[t]);
+      bool first = true;
+      while (k > 0 && slot[k - 1] == slot[k] && first) first = !dirty[--k];
+      if (first) sum_run(k);
+    }
+  });
 }
 
 void bayes_sampler::sample_done(row_state& row, int pixel, vec3f l) const {
@@ -316,6 +453,7 @@ void bayes_sampler::begin_frame(double decay) {
   if (decay >= 1) return;
   decay_stats(stats, decay, params);
   refresh_weights(stats, &regions.pair_parent, params);
+  refresh_groups(nullptr);
 }
 
 void bayes_sampler::add_pairs(int first_region) {
@@ -326,7 +464,7 @@ void bayes_sampler::add_pairs(int first_region) {
   first_child.resize(npairs, invalid_id);
   next_sibling.resize(npairs, invalid_id);
   for (size_t r = size_t(first_region); r < regions.key.size(); r++) {
-    size_t b = size_t(regions.pair_offset[r]), e = b + size_t(regions.cut_size[r]);
+    size_t b = size_t(regions.pair_offset[r]), e = b + size_t(regions.pair_count[r]);
     for (size_t k = b; k < e; k++) {
       int up = regions.pair_parent[k];
       if (up == invalid_id) continue;
@@ -345,9 +483,9 @@ void bayes_sampler::add_pairs(int first_region) {
     for (int r = range.begin(); r < range.end(); r++) {
       bbox3f box = padded(region_box(regions.grid, regions.key[size_t(r)]));
       vec3f mid = center(box);
-      const int* nodes = regions.cut_nodes.data() + regions.cut_offset[size_t(r)];
+      const int* nodes = regions.pair_node.data() + regions.pair_offset[size_t(r)];
       float* out = stats.mu0.data() + regions.pair_offset[size_t(r)];
-      for (int j = 0; j < regions.cut_size[size_t(r)]; j++) {
+      for (int j = 0; j < regions.pair_count[size_t(r)]; j++) {
         int node = nodes[j];
         if (node == sun_cluster) {
           out[j] = sun_mu0;
@@ -373,6 +511,7 @@ void bayes_sampler::rebuild_posterior() {
   add_pairs(0);
   for (size_t i = 0; i < n; i++) update_coeffs(stats, i, params);
   refresh_weights(stats, &regions.pair_parent, params);
+  refresh_groups(nullptr);
 }
 
 void bayes_sampler::learn(std::vector<row_state>& rows) {
@@ -401,7 +540,14 @@ void bayes_sampler::learn(std::vector<row_state>& rows) {
 void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
   const bool hier = params.hierarchy > 0 && params.prior;
   std::atomic<int64_t> folds{0};  // counted per task (profiles)
-  auto fold = [&](size_t i) { fold_weight(stats, i, hier ? regions.pair_parent[i] : invalid_id, params); };
+  tbb::enumerable_thread_specific<std::vector<int>> children;  // members: refolded children, per thread (any order)
+  // Members: a refolded pair is flagged (each pair is folded by one task at a time) for refresh_groups.
+  std::vector<uint8_t>& dirty = stats.scratch.dirty;
+  if (regions.members) dirty.resize(stats.m.size(), 0);
+  auto fold = [&](size_t i) {
+    fold_weight(stats, i, hier ? regions.pair_parent[i] : invalid_id, params);
+    if (regions.members) dirty[i] = 1;
+  };
   // Children of coarse pairs whose p1 moved by more than the tolerance since their children were last examined. A
   // child's p1 = (s p1_parent + n1) / (s + n) moves, relative to itself, by at most the parent's relative move; an
   // examined child is refolded when its own p1 moved by more than the tolerance from the one its weight holds (a
@@ -465,12 +611,23 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
         }
         for (int c = first_child[size_t(k)]; c != invalid_id; c = next_sibling[size_t(c)])
           if (((flags & mean_moved) && stats.mu0[size_t(c)] > low) ||
-              ((flags & p1_moved) && moved_by(pair_p1(stats, size_t(c), k, params), stats.p1_folded[size_t(c)])))
+              ((flags & p1_moved) && moved_by(pair_p1(stats, size_t(c), k, params), stats.p1_folded[size_t(c)]))) {
+            if (regions.members && !dirty[size_t(c)]) children.local().push_back(c);  // not listed yet
             fold(size_t(c)), count++;
+          }
       }
       folds.fetch_add(count, std::memory_order_relaxed);
     });
   timing.refolds += double(folds.load());
+  if (!regions.members) return;
+  // The clusters of every refolded pair (listed once each) sum their members' weights again.
+  std::vector<int> folded(touched);
+  for (size_t i = old_pairs; i < pairs; i++) folded.push_back(int(i));
+  for (const std::vector<int>& c : children) folded.insert(folded.end(), c.begin(), c.end());
+  refresh_groups(&folded);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, folded.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t < r.end(); t++) dirty[size_t(folded[t])] = 0;
+  });
 }
 
 }  // namespace bl

@@ -57,12 +57,23 @@ struct bayes_sampler {
   // Region-prior mode's weights at a point (prepare's fast path): W of each pair times 1 / d^2, zero for clusters
   // entirely behind the point's surface.
   void prepare_region_prior(context& ctx, const shade_point& sp) const;
+  // A cluster by the point's cdf, then (a cluster of several members) a member by its weight, the cluster's share
+  // of u rescaled to [0, 1) choosing it (so a stratified u stays stratified inside the cluster), then a light of the
+  // member by intensity. light_choice::cluster is the member (the pair within the region).
   light_choice sample(const context& ctx, double u, double u_inner) const {
     if (fallback) return power.sample({}, u, u_inner);
-    return sample_cut(ctx, *tree, *lights, u, u_inner);
+    if (ctx.pair_count == ctx.count) return sample_cut(ctx, *tree, *lights, u, u_inner);
+    return sample_members(ctx, u, u_inner);
   }
   float pmf(const context& ctx, int light) const {
-    return fallback ? power.pmf({}, light) : cut_pmf(ctx, *tree, *lights, light);
+    if (fallback) return power.pmf({}, light);
+    return ctx.pair_count == ctx.count ? cut_pmf(ctx, *tree, *lights, light) : members_pmf(ctx, light);
+  }
+  light_choice sample_members(const context& ctx, double u, double u_inner) const;
+  float members_pmf(const context& ctx, int light) const;
+  // The cluster (cut entry) of member m of the context's region.
+  int group_of(const context& ctx, int m) const {
+    return ctx.pair_count == ctx.count ? m : regions.pair_slot[size_t(ctx.pair_base + m)] - ctx.group_base;
   }
   void record(row_state& row, const nee_event<context>& e) const;
   void sample_done(row_state& row, int pixel, vec3f l) const;
@@ -78,11 +89,15 @@ struct bayes_sampler {
   // Control variates (prepare set ctx.cv): the emission colour of cluster j (luminance 1), the colour-weighted sum
   // of every cluster's learned mean c_j, and c_J of one cluster in colour.
   vec3f cluster_color(const context& ctx, int j) const {
-    int node = ctx.nodes[j];
+    int node = ctx.members[j];
     return node == sun_cluster ? sun_color : tree->color[size_t(node)];
   }
   vec3f cv_total(const context& ctx) const { return ctx.cv_sum; }
-  vec3f cv_cluster(const context& ctx, int j) const { return cluster_color(ctx, j) * ctx.cvg[j]; }
+  // c_m of member m (a cluster when every cluster is its own member, then from ctx.cvg).
+  vec3f cv_cluster(const context& ctx, int m) const {
+    if (ctx.pair_count == ctx.count) return cluster_color(ctx, m) * ctx.cvg[m];
+    return cluster_color(ctx, m) * (stats.cv[size_t(ctx.pair_base + m)] * ctx.gfac[group_of(ctx, m)]);
+  }
   void learn(std::vector<row_state>& rows);
   // Sizes the statistics for every region and sets the region-level prior means of the pairs of regions
   // [first_region, end) (a function of each region's box and cut only). Weights are refolded by the caller.
@@ -93,6 +108,10 @@ struct bayes_sampler {
   void refold(const std::vector<int>& touched, size_t old_pairs);
   // Recomputes every derived column (prior means, coefficients, weights) from the regions and statistics.
   void rebuild_posterior();
+  // Members: recomputes the cluster columns (gw, gw_cv, gcv) of the clusters of the given pairs (nullptr: all) from
+  // their members' weights. Each cluster's sum runs over its members in order: a function of the weights only.
+  // Given pairs must be listed once each and flagged in stats.scratch.dirty (refold does both).
+  void refresh_groups(const std::vector<int>* pairs);
   // Scales every statistic by `decay` (the prior regains weight) and refreshes the weights.
   void begin_frame(double decay);
 };

@@ -92,6 +92,7 @@ struct pair_moments {
 struct merge_buffers {
   std::vector<std::vector<int>> touched;       // per bucket: the pairs it updated
   std::vector<uint8_t> seen;                   // per pair: already in a touched list (all zero between calls)
+  std::vector<uint8_t> dirty;                  // per pair: refolded in this refold (members; all zero between calls)
 };
 
 struct bayes_stats {
@@ -106,6 +107,8 @@ struct bayes_stats {
                                          // a child's p1 folded into its weight
   std::vector<float> k_folded;           // mean hierarchy, per parent pair: its posterior mean when its children were
                                          // last examined for it
+  std::vector<float> gw, gw_cv, gcv;     // members (region_state::members), per cut entry: the sums of its members'
+                                         // w, w_cv and cv (+ 4 padding each), what a point weighs the cluster by
   merge_buffers scratch;
 };
 

@@ -15,9 +15,9 @@ namespace bl {
 namespace {
 
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
-constexpr uint32_t version = 8;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
+constexpr uint32_t version = 9;  // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos;
                                  // 5: mean hierarchy (k_folded); 6: bayes fallback check; 7: no point-prior
-                                 // weights in region-prior mode; 8: the stratified set's first sample
+                                 // weights in region-prior mode; 8: the stratified set's first sample; 9: members
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -93,6 +93,11 @@ void write_regions(writer& w, const region_state& s) {
   w.column(s.cut_nodes);
   w.column(s.pair_parent);
   w.value(s.pairs);
+  w.value(uint8_t(s.members));
+  w.column(s.member_begin);
+  w.column(s.pair_count);
+  w.column(s.pair_node);
+  w.column(s.pair_slot);
   w.column(s.pending);
   w.value(uint64_t(s.pending_count));
 }
@@ -107,13 +112,28 @@ void read_regions(reader& r, region_state& s) {
   s.cut_nodes = r.column<int>();
   s.pair_parent = r.column<int>();
   s.pairs = r.value<int64_t>();
+  if (s.pairs != int64_t(s.pair_parent.size())) r.fail("pair count");
+  s.members = r.value<uint8_t>() != 0;
+  s.member_begin = r.column<int>(s.cut_nodes.size());
+  s.pair_count = r.column<int>(n);
+  s.pair_node = r.column<int>(size_t(s.pairs));
+  s.pair_slot = r.column<int>(size_t(s.pairs));
   s.pending = r.column<region_slot>();
   s.pending_count = size_t(r.value<uint64_t>());
-  if (s.pairs != int64_t(s.pair_parent.size())) r.fail("pair count");
-  for (size_t i = 0; i < n; i++)
-    if (s.cut_offset[i] < 0 || s.cut_size[i] < 0 || size_t(s.cut_offset[i]) + size_t(s.cut_size[i]) > s.cut_nodes.size() ||
-        s.pair_offset[i] < 0 || int64_t(s.pair_offset[i]) + s.cut_size[i] > s.pairs)
+  for (size_t i = 0; i < n; i++) {
+    int c = s.cut_size[i], m = s.pair_count[i];
+    if (s.cut_offset[i] < 0 || c < 0 || size_t(s.cut_offset[i]) + size_t(c) > s.cut_nodes.size() ||
+        s.pair_offset[i] < 0 || m < c || (!s.members && m != c) || int64_t(s.pair_offset[i]) + m > s.pairs)
       r.fail("region layout");
+    // Every cluster's members: consecutive, a positive run each, their pairs naming that cluster.
+    const int* begin = s.member_begin.data() + s.cut_offset[i];
+    for (int g = 0; g < c; g++) {
+      int e = g + 1 < c ? begin[g + 1] : m;
+      if (begin[g] < 0 || begin[g] >= e || (g == 0 && begin[g] != 0)) r.fail("region members");
+      for (int k = begin[g]; k < e; k++)
+        if (s.pair_slot[size_t(s.pair_offset[i] + k)] != s.cut_offset[i] + g) r.fail("region members");
+    }
+  }
   if (!s.pending.empty() && (s.pending.size() & (s.pending.size() - 1)) != 0) r.fail("pending table size");
   // The lookup table is rebuilt from the keys (its layout does not matter, its answers do).
   rebuild_region_table(s);
@@ -210,6 +230,7 @@ void read_sampler(reader& r, light_sampler& ls) {
     b->stats.cv = std::move(cv);
     b->stats.p1_folded = std::move(p1_folded);
     b->stats.k_folded = std::move(k_folded);
+    b->refresh_groups(nullptr);  // the clusters' sums of the saved weights
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
     read_regions(r, d->deeper.regions);
@@ -250,6 +271,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   const region_params& r = p.sampler.regions;
   h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
   h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
+  h.value(r.max_members);
   const bayes_params& b = p.sampler.bayes;
   h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);

@@ -324,6 +324,11 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--cut-coherence", o.regions.coherence,
                 "Keep a light cluster whole when its radius / gap to the region <= this (default 0.25; 0 = off)")
       ->check(CLI::Range(0.0, 100.0))->check(finite_number)->group(grp);
+  r->add_option("--cut-members", o.regions.max_members,
+                "bayes: clusters of a region's cut are refined into at most this many members in all, each learned "
+                "apart and chosen inside its cluster (default 128 with --max-depth 1, else 0; 0 or at most the cut "
+                "size: none refined; at most 1024)")
+      ->check(CLI::Range(0, 1024))->group(grp);
   r->add_option("--shared-cut-lights", o.regions.shared_cut_lights,
                 "Scenes with at most this many lights give every region a cut of all lights, no clustering (default 16; "
                 "0: always clustered cuts)")

@@ -28,6 +28,10 @@ void locate_region(cut_context& ctx, const region_state& regions, const shade_po
     ctx.count = e->cut_size;
     ctx.nodes = regions.cut_nodes.data() + e->cut_offset;
     ctx.tree_count = ctx.count - (regions.has_sun ? 1 : 0);
+    ctx.pair_count = e->pair_count;
+    ctx.members = regions.pair_node.data() + e->pair_offset;
+    ctx.member_begin = regions.member_begin.data() + e->cut_offset;
+    ctx.group_base = e->cut_offset;
   }
 }
 
@@ -40,10 +44,10 @@ light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, con
   double pj = cluster_pmf(ctx, j);
   if (!(pj > 0)) return {};
   int node = ctx.nodes[j];
-  if (node == sun_cluster) return {lights.sun, float(pj), j, 1.0f};
+  if (node == sun_cluster) return {lights.sun, float(pj), j, 1.0f, pj};
   double inner = 1;
   int leaf = sample_by_intensity(tree, node, u_inner, inner);
-  return {tree.light[size_t(leaf)], float(pj * inner), j, float(inner)};
+  return {tree.light[size_t(leaf)], float(pj * inner), j, float(inner), pj};
 }
 
 float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, int light) {

@@ -30,6 +30,13 @@ struct cut_context {
   int count = 0;               // clusters in the cut
   int tree_count = 0;          // of which tree nodes (the sun, if any, is last)
   const int* nodes = nullptr;  // the cut's node ids
+  // Members (region_state): the region's member count (= pairs), their nodes, each cluster's first member, and
+  // the cut's first column index (the region's cut_offset: group columns are indexed by it plus the cluster).
+  int pair_count = 0;
+  const int* members = nullptr;
+  const int* member_begin = nullptr;
+  int group_base = 0;
+  const float* member_w = nullptr;  // bayes: the members' weight column a point chose from (inside a cluster)
   double cdf[max_cut_entries + 1];
   // Control variates (bayes): whether they apply at this point, sum_j colour_j c_j and c_j per cluster, with c_j
   // the learned mean of cluster j's albedo-free sample (the integrator scales by (kd + ks) / pi).

@@ -31,6 +31,8 @@ void donikian_sampler::prepare(context& ctx, const shade_point& sp) const {
   ctx.nodes = cut.data();
   ctx.count = k;
   ctx.tree_count = tree_count;
+  ctx.members = cut.data();  // one member per cluster
+  ctx.pair_count = k;
   int x = sp.pixel % width, y = sp.pixel / width;
   int bw = (width + params.block - 1) / params.block;
   size_t b = size_t(y / params.block) * size_t(bw) + size_t(x / params.block);

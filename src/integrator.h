@@ -221,8 +221,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
         // Control variate (unweighted NEE only): sum_j c_j + (Y_J - c_J) / P_J, the Y_J / P_J part added above;
         // c_j in colour is the cluster's learned albedo-free mean times (kd + ks) / pi.
         if (ctx.cv) {
-          double pj = cluster_pmf(ctx, choice.cluster);
-          vec3f c = sampler.cv_total(ctx) - sampler.cv_cluster(ctx, choice.cluster) * float(1 / pj);
+          vec3f c = sampler.cv_total(ctx) - sampler.cv_cluster(ctx, choice.cluster) * float(1 / choice.cluster_prob);
           vec3f add = beta * (bsdf.kd + bsdf.ks) * inv_pi_f * c;
           radiance += add;
           added_total += luminance(add);

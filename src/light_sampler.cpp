@@ -32,9 +32,15 @@ std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_g
 }
 
 // Regions of a cut-based sampler: the grid, the root, and the regions of directly visible surfaces.
-region_state make_regions(const sampler_params& params, const render_inputs& in, const light_tree_data& tree) {
+// `members`: whether clusters are refined into learned members (bayes with the region prior only).
+region_state make_regions(const sampler_params& params, const render_inputs& in, const light_tree_data& tree,
+                          bool members = false) {
   region_params rp = params.regions;
   rp.max_cut = std::min(std::max(rp.max_cut, 1), max_cut_entries - 1);
+  // Members by default in direct illumination only: there NEE at the first hit is the whole estimate, while in path
+  // tracing most NEE events are at deep vertices and refined learning costs more time than it saves (README).
+  if (rp.max_members < 0) rp.max_members = in.max_depth == 1 ? region_params::auto_members : 0;
+  rp.max_members = members ? std::min(rp.max_members, max_cut_entries - 1) : 0;
   region_state s = make_region_state(in.scene->bounds, tree, in.lights->sun != invalid_id, rp);
   add_regions(s, tree, camera_region_keys(in, s.grid));
   return s;
@@ -116,9 +122,10 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.power = power_sampler{make_discrete(lights.power.data(), lights.count)};
       if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
         s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);
-      s.regions = make_regions(params, in, tree);
+      s.regions = make_regions(params, in, tree, s.params.region_prior);
       s.add_pairs(0);
       refresh_weights(s.stats, &s.regions.pair_parent, s.params);
+      s.refresh_groups(nullptr);
       return s;
     }
     default: break;
@@ -138,7 +145,7 @@ size_t sampler_memory_bytes(const light_sampler& s) {
     const bayes_stats& st = b->stats;
     return region_memory_bytes(b->regions) + bytes_of(st.m) + bytes_of(st.coeffs) + bytes_of(st.weight) +
            bytes_of(st.mu0) + bytes_of(st.w) + bytes_of(st.w_cv) + bytes_of(st.cv) + bytes_of(st.p1_folded) +
-           bytes_of(st.k_folded) + bytes_of(b->first_child) + bytes_of(b->next_sibling) + bytes_of(b->px_var) +
+           bytes_of(st.k_folded) + bytes_of(st.gw) + bytes_of(st.gw_cv) + bytes_of(st.gcv) + bytes_of(b->first_child) + bytes_of(b->next_sibling) + bytes_of(b->px_var) +
            bytes_of(b->px_delta) + bytes_of(b->px_prev);
   }
   if (auto* d = std::get_if<donikian_sampler>(&s))

@@ -58,6 +58,7 @@ struct light_choice {
   float prob = 0;
   int cluster = invalid_id;
   float prob_in_cluster = 1;  // P(light | cluster); prob = P(cluster) * prob_in_cluster (both rounded from double)
+  double cluster_prob = 0;    // P(cluster), where `cluster` is set
 };
 
 // One NEE event as a learning sampler sees it: its own context, the choice, and the sample's luminance

@@ -30,7 +30,7 @@ void table_insert(region_state& s, int id) {
   size_t r = size_t(id);
   size_t h = size_t(mix64(s.key[r])) & mask;
   while (s.table[h].key != empty_region_key) h = (h + 1) & mask;
-  s.table[h] = {s.key[r], id, s.cut_size[r], s.cut_offset[r], s.pair_offset[r]};
+  s.table[h] = {s.key[r], id, s.cut_size[r], s.cut_offset[r], s.pair_offset[r], s.pair_count[r]};
 }
 
 // Grows the table to keep its load at most 1/2 for `regions` entries.
@@ -38,13 +38,21 @@ void reserve_table(region_state& s, size_t regions) {
   size_t want = 16;
   while (want < 2 * regions) want *= 2;
   if (want <= s.table.size()) return;
-  s.table.assign(want, region_entry{empty_region_key, invalid_id, 0, 0, 0});
+  s.table.assign(want, region_entry{empty_region_key, invalid_id, 0, 0, 0, 0});
   for (size_t r = 0; r < s.key.size(); r++) table_insert(s, int(r));
 }
 
-// Appends a region with the given cut (or the shared cut 0) under `parent` (or invalid_id), linking each of
-// its pairs to the parent's pair of the same cluster (cuts are sorted, so one merge walk finds them).
-int append_region(region_state& s, uint64_t key, const std::vector<int>* cut, int parent) {
+// The last node of `node`'s subtree in depth-first numbering: its rightmost leaf.
+int subtree_last(const light_tree_data& tree, int node) {
+  while (!is_leaf(tree, node)) node = tree.right[size_t(node)];
+  return node;
+}
+
+// Appends a region with the given cut (or the shared cut 0) and members (or one per cluster; `tree` is needed with
+// members) under `parent` (or invalid_id), linking each of its pairs to the parent's pair of the same member node, or
+// with members of the subtree holding it (members are sorted, so one merge walk finds them).
+int append_region(region_state& s, uint64_t key, const std::vector<int>* cut, const std::vector<int>* members,
+                  const std::vector<int>* group, int parent, const light_tree_data* tree = nullptr) {
   int id = int(s.key.size());
   s.key.push_back(key);
   s.parent.push_back(parent);
@@ -52,23 +60,41 @@ int append_region(region_state& s, uint64_t key, const std::vector<int>* cut, in
     s.cut_offset.push_back(int(s.cut_nodes.size()));
     s.cut_size.push_back(int(cut->size()));
     s.cut_nodes.insert(s.cut_nodes.end(), cut->begin(), cut->end());
+    s.member_begin.resize(s.cut_nodes.size(), 0);
   } else {
     s.cut_offset.push_back(0);
     s.cut_size.push_back(s.cut_size.empty() ? 0 : s.cut_size[0]);
   }
+  int groups = s.cut_size.back(), offset = s.cut_offset.back();
+  const int* cut_nodes = s.cut_nodes.data() + offset;
+  int n = members ? int(members->size()) : groups;
   s.pair_offset.push_back(int(s.pairs));
-  int n = s.cut_size.back();
+  s.pair_count.push_back(n);
   s.pairs += n;
-  const int* mine = s.cut_nodes.data() + s.cut_offset.back();
+  for (int j = 0; j < n; j++) {
+    int g = members ? (*group)[size_t(j)] : j;
+    s.pair_node.push_back(members ? (*members)[size_t(j)] : cut_nodes[g]);
+    s.pair_slot.push_back(offset + g);
+    if (cut && (!members || j == 0 || g != (*group)[size_t(j - 1)])) s.member_begin[size_t(offset + g)] = j;
+  }
+  const int* mine = s.pair_node.data() + s.pair_offset.back();
   for (int j = 0; j < n; j++) s.pair_parent.push_back(invalid_id);
   if (parent != invalid_id) {
-    const int* theirs = s.cut_nodes.data() + s.cut_offset[size_t(parent)];
-    int m = s.cut_size[size_t(parent)];
+    const int* theirs = s.pair_node.data() + s.pair_offset[size_t(parent)];
+    int m = s.pair_count[size_t(parent)];
     int* links = s.pair_parent.data() + s.pair_offset.back();
-    // Both cuts hold ascending node ids, then possibly sun_cluster (-2) last.
+    // Both member lists hold ascending node ids, then possibly sun_cluster (-2) last. A member links to the parent's
+    // member of the same node, or (members refined: the parent, a coarse region, is not) of the subtree holding it:
+    // depth-first ids, so a subtree's nodes run from its root to the last leaf down its right children, and the
+    // parent's members are disjoint such ranges in ascending order.
     for (int j = 0, k = 0; j < n; j++) {
       if (mine[j] == sun_cluster) {
         if (m > 0 && theirs[m - 1] == sun_cluster) links[j] = s.pair_offset[size_t(parent)] + m - 1;
+        continue;
+      }
+      if (members) {
+        while (k < m && theirs[k] != sun_cluster && subtree_last(*tree, theirs[k]) < mine[j]) k++;
+        if (k < m && theirs[k] != sun_cluster && theirs[k] <= mine[j]) links[j] = s.pair_offset[size_t(parent)] + k;
         continue;
       }
       while (k < m && theirs[k] != sun_cluster && theirs[k] < mine[j]) k++;
@@ -120,10 +146,11 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
     if (has_sun) all.push_back(sun_cluster);
   }
   uint64_t root_key = make_key(2, 0, 0, 0);
-  if (s.shared_cut) append_region(s, root_key, &all, invalid_id);
+  s.members = !s.shared_cut && params.max_members > 0;
+  if (s.shared_cut) append_region(s, root_key, &all, nullptr, nullptr, invalid_id);
   else {
     std::vector<int> cut = compute_light_cut(tree, padded(b), has_sun, params);
-    append_region(s, root_key, &cut, invalid_id);
+    append_region(s, root_key, &cut, nullptr, nullptr, invalid_id);  // the root, like coarse regions, unrefined
   }
   s.root = 0;
   return s;
@@ -231,42 +258,45 @@ int find_region(const region_state& s, uint64_t fine_key) {
 }
 
 int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys) {
-  // Decide which regions to create, in key order (coarse parents first; fine ones while the budget allows).
-  // Ids follow this order, so they do not depend on threads; the cuts are then computed in parallel (each is
-  // a function of its key only) and appended in the same order.
+  // The candidates in key order (each fine key after its coarse parent, if that is new); their cuts and members are
+  // computed in parallel (each a function of its key only); then, in the same order, coarse regions are created and
+  // fine ones while their actual pairs fit the budget. Ids follow this order, so they do not depend on threads.
   struct pending {
     uint64_t key;
     uint64_t parent_key;  // empty_region_key for coarse regions
   };
   std::vector<pending> todo;
   std::vector<uint64_t> new_coarse;
-  int64_t per_region = s.shared_cut ? std::max(1, s.cut_size[0]) : s.params.max_cut + 1;
-  int64_t pairs = s.pairs;
   for (uint64_t key : fine_keys) {
     if (find_region_key(s, key) != invalid_id) continue;
     bool coarse_only = is_coarse_key(key);
     uint64_t ckey = coarse_only ? key : parent_region_key(s.grid, key, 1);
     if (find_region_key(s, ckey) == invalid_id && std::find(new_coarse.begin(), new_coarse.end(), ckey) == new_coarse.end()) {
-      // Coarse regions are at most 1/512 of the fine ones; they ignore the budget.
       new_coarse.push_back(ckey);
       todo.push_back({ckey, empty_region_key});
-      pairs += per_region;
     }
-    if (coarse_only) continue;
-    if (pairs + per_region > s.params.max_pairs) continue;  // over budget: the coarse region serves
-    todo.push_back({key, ckey});
-    pairs += per_region;
+    if (!coarse_only) todo.push_back({key, ckey});
   }
-  std::vector<std::vector<int>> cuts(s.shared_cut ? 0 : todo.size());
+  size_t cuts_needed = s.shared_cut ? 0 : todo.size();
+  std::vector<std::vector<int>> cuts(cuts_needed), members(s.members ? cuts_needed : 0), group(members.size());
   if (!s.shared_cut)
     tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) {
-      cuts[i] = compute_light_cut(tree, padded(region_box(s.grid, todo[i].key)), s.has_sun, s.params);
+      bbox3f box = padded(region_box(s.grid, todo[i].key));
+      cuts[i] = compute_light_cut(tree, box, s.has_sun, s.params);
+      if (s.members) compute_members(tree, box, cuts[i], s.params.max_members, members[i], group[i]);
     });
+  int added = 0;
   for (size_t i = 0; i < todo.size(); i++) {
-    int parent = todo[i].parent_key == empty_region_key ? invalid_id : find_region_key(s, todo[i].parent_key);
-    append_region(s, todo[i].key, s.shared_cut ? nullptr : &cuts[i], parent);
+    bool coarse = todo[i].parent_key == empty_region_key;
+    int64_t n = s.shared_cut ? s.cut_size[0] : s.members ? int64_t(members[i].size()) : int64_t(cuts[i].size());
+    // Coarse regions are at most 1/512 of the fine ones; they ignore the budget. Over budget, the coarse region serves.
+    if (!coarse && s.pairs + n > s.params.max_pairs) continue;
+    int parent = coarse ? invalid_id : find_region_key(s, todo[i].parent_key);
+    append_region(s, todo[i].key, s.shared_cut ? nullptr : &cuts[i], s.members ? &members[i] : nullptr,
+                  s.members ? &group[i] : nullptr, parent, &tree);
+    added++;
   }
-  return int(todo.size());
+  return added;
 }
 
 // Whether node's lights light every point of the box in nearly the same proportions (splitting it would
@@ -318,8 +348,60 @@ std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool
   return cut;
 }
 
+void compute_members(const light_tree_data& tree, bbox3f box, const std::vector<int>& cut, int max_members,
+                     std::vector<int>& members, std::vector<int>& group) {
+  members.clear();
+  group.clear();
+  // Max-heap of (bound, node, cut entry); ties go to the smaller node id, so the members depend on the box only.
+  struct entry {
+    float bound;
+    int node, g;
+  };
+  auto less = [](const entry& a, const entry& b) { return a.bound < b.bound || (a.bound == b.bound && a.node > b.node); };
+  std::priority_queue<entry, std::vector<entry>, decltype(less)> heap(less);
+  std::vector<std::pair<int, int>> done;  // (node, cut entry) of members that stay whole
+  for (int g = 0; g < int(cut.size()); g++) {
+    int node = cut[size_t(g)];
+    if (node == sun_cluster || is_leaf(tree, node)) done.push_back({node, g});
+    else heap.push({node_region_bound(tree, node, box.lo, box.hi), node, g});
+  }
+  int count = int(cut.size());
+  while (!heap.empty() && count < max_members) {
+    entry top = heap.top();
+    heap.pop();
+    entry kids[2];
+    int kept = 0;
+    for (int child : {tree.left[size_t(top.node)], tree.right[size_t(top.node)]}) {
+      float b = node_region_bound(tree, child, box.lo, box.hi);
+      if (b > 0) kids[kept++] = {b, child, top.g};  // a subtree that cannot light the box is left out, as in cuts
+    }
+    if (kept == 0) {
+      done.push_back({top.node, top.g});  // (bounds are conservative: not expected, but never drop a whole member)
+      continue;
+    }
+    count += kept - 1;
+    for (int k = 0; k < kept; k++) {
+      if (is_leaf(tree, kids[k].node)) done.push_back({kids[k].node, kids[k].g});
+      else heap.push(kids[k]);
+    }
+  }
+  for (; !heap.empty(); heap.pop()) done.push_back({heap.top().node, heap.top().g});
+  // Depth-first node ids: a subtree's ids follow its root's, so sorting by id keeps every group's members together
+  // and the groups in cut order; the sun (-2) goes last, as in the cut.
+  std::sort(done.begin(), done.end(), [](const std::pair<int, int>& a, const std::pair<int, int>& b) {
+    bool sa = a.first == sun_cluster, sb = b.first == sun_cluster;
+    return sa != sb ? sb : a.first < b.first;
+  });
+  for (const auto& d : done) {
+    members.push_back(d.first);
+    group.push_back(d.second);
+  }
+}
+
 size_t region_memory_bytes(const region_state& s) {
-  return s.key.size() * (sizeof(uint64_t) + 4 * sizeof(int)) + (s.cut_nodes.size() + s.pair_parent.size()) * sizeof(int) +
+  return s.key.size() * (sizeof(uint64_t) + 5 * sizeof(int)) +
+         (s.cut_nodes.size() + s.member_begin.size() + s.pair_parent.size() + s.pair_node.size() +
+          s.pair_slot.size()) * sizeof(int) +
          s.table.size() * sizeof(region_entry) + s.pending.size() * sizeof(region_slot);
 }
 

@@ -23,6 +23,11 @@ struct region_params {
   float coherence = 0.25f;         // keep a node whole when radius / gap to the region <= this and its
                                    // normals lie within 30 degrees (its lights light the region alike)
   int shared_cut_lights = 16;      // at most this many lights: one cut of all lights, no clustering
+  int max_members = -1;            // learned sub-clusters per region (bayes): the clusters of a region's cut are
+                                   // refined into at most this many members in all, whose statistics are learned
+                                   // apart and chosen inside their cluster (0 or at most the cut size: one member
+                                   // per cluster, i.e. none refined); -1: auto_members by the path depth
+  static constexpr int auto_members = 128;  // the default in direct illumination (max depth 1); 0 in path tracing
   int min_samples = 16;            // NEE samples a fine cell must ask for before its region is created
   int fine_depth = 1;              // path vertices up to this depth use fine regions, deeper ones coarse regions
   int64_t max_pairs = int64_t(1) << 20;  // memory budget in (region, cluster) pairs
@@ -48,7 +53,7 @@ struct region_slot {
 // lookup touches one cache line.
 struct region_entry {
   uint64_t key;
-  int id, cut_size, cut_offset, pair_offset;
+  int id, cut_size, cut_offset, pair_offset, pair_count;
 };
 
 // Regions as flat columns, plus the key -> region lookup table.
@@ -57,14 +62,23 @@ struct region_state {
   region_params params;
   bool has_sun = false;
   bool shared_cut = false;             // few lights: every region uses cut 0 (all lights), no clustering
+  bool members = false;                // clusters of fine and coarse regions are refined into members
+                                       // (params.max_members, not shared_cut); the root is not
   std::vector<uint64_t> key;           // per region
   std::vector<int> cut_offset;         // per region: first entry in cut_nodes
   std::vector<int> cut_size;           // per region
   std::vector<int> pair_offset;        // per region: its first (region, cluster) pair
   std::vector<int> parent;             // per region: the coarse region containing a fine one (else invalid_id)
   std::vector<int> cut_nodes;          // concatenated sorted cuts (tree node ids, then sun_cluster)
-  std::vector<int> pair_parent;        // per pair: the parent region's pair of the same cluster, or invalid_id
-  int64_t pairs = 0;                   // total (region, cluster) pairs
+  // Members: each cluster of a cut (a group) holds one or more members, subtrees of its node (or the sun), whose
+  // pairs carry the statistics; a region's members are sorted like its cut, so a group's members are contiguous
+  // and in the order of the groups. Without refinement every group has one member, itself.
+  std::vector<int> member_begin;       // per cut entry: its group's first member (index within the region)
+  std::vector<int> pair_count;         // per region: its members (= pairs)
+  std::vector<int> pair_node;          // per pair: the member's tree node (or sun_cluster)
+  std::vector<int> pair_slot;          // per pair: cut_offset of its region + its group (the group's column index)
+  std::vector<int> pair_parent;        // per pair: the parent region's pair of the same member node, or invalid_id
+  int64_t pairs = 0;                   // total (region, member) pairs
   std::vector<region_entry> table;     // open addressing; empty slots hold empty_region_key
   std::vector<region_slot> pending;    // fine keys not yet created -> NEE samples requested so far (same scheme)
   size_t pending_count = 0;
@@ -111,6 +125,13 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
 // conservative bounds in order of decreasing bound, except that coherent nodes (small and far as seen from
 // the box, narrow normal cone) stay whole; nodes that cannot light any point of the box are left out.
 std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool has_sun, const region_params& p);
+
+// The members of a region's cut (see region_state): every cluster that is a tree node is refined, largest
+// bound over the box first, into subtrees whose bound over the box is non-zero, until the cut holds `max_members`
+// members or only leaves remain; sorted by node id, the sun (if in the cut) last. group[i]: the cut entry that
+// member i refines.
+void compute_members(const light_tree_data& tree, bbox3f box, const std::vector<int>& cut, int max_members,
+                     std::vector<int>& members, std::vector<int>& group);
 
 // Bytes used by the region state (columns and table).
 size_t region_memory_bytes(const region_state& s);

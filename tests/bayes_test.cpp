@@ -192,8 +192,9 @@ shade_point pixel_point(const test_scene& t, int x, int y) {
   return shade_point{sp.p, sp.ng, 0.5f, y * t.in.camera.width + x, 1};
 }
 
-// A bayes sampler over make_scene(3, false) whose cuts are the 3 lamps (3 clusters, not a shared cut of 6 leaves),
-// with bayes parameters `bp`, and a context prepared at pixel (4, 4) whose cut is those 3 clusters.
+// A bayes sampler over make_scene(3, false) whose cuts are the 3 lamps (3 clusters, not a shared cut of 6 leaves,
+// and not refined into members: each cluster is one pair, whose posterior the tests below follow), with bayes
+// parameters `bp`, and a context prepared at pixel (4, 4) whose cut is those 3 clusters.
 struct three_lamps {
   std::unique_ptr<test_scene> t;
   std::optional<light_sampler> ls;
@@ -207,6 +208,7 @@ three_lamps make_three_lamps(const bayes_params& bp) {
   sampler_params sp;
   sp.kind = sampler_kind::bayes;
   sp.regions.shared_cut_lights = 0;
+  sp.regions.max_members = 0;
   sp.bayes = bp;
   f.ls.emplace(make_light_sampler(sp, f.t->in, f.t->tree));
   f.pt = pixel_point(*f.t, 4, 4);

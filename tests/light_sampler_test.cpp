@@ -288,8 +288,8 @@ contract_report check_contract(const test_scene& t, const S& s, const std::vecto
       if constexpr (std::is_same_v<typename S::context, cut_context>) {
         // prob = P(cluster) * P(light | cluster), the split the learner's observations rely on (both factors are
         // rounded from double separately, so the product agrees to float resolution, not bit for bit).
-        bool valid = c.cluster >= 0 && c.cluster < ctx.count;
-        double split = valid ? cluster_pmf(ctx, c.cluster) * double(c.prob_in_cluster) : 0.0;
+        bool valid = c.cluster >= 0 && c.cluster < ctx.pair_count && c.cluster_prob > 0 && c.cluster_prob <= 1;
+        double split = valid ? c.cluster_prob * double(c.prob_in_cluster) : 0.0;
         if (!valid || std::fabs(double(c.prob) - split) > 2e-7 * split)
           rep.bad_cluster_split++;
       }
@@ -328,15 +328,19 @@ void require_contract(const contract_report& r) {
 const sampler_kind all_kinds[] = {sampler_kind::uniform, sampler_kind::power, sampler_kind::bvh, sampler_kind::bound,
                                   sampler_kind::donikian, sampler_kind::bayes};
 
-// Region options of the cut-based samplers: the defaults, and small cuts on a coarse grid (clusters of many
-// lights, so the intensity descent inside clusters is exercised).
+// Region options of the cut-based samplers: the defaults, small cuts on a coarse grid without members (clusters of
+// many lights, so the intensity descent inside clusters is exercised), and those small cuts with members (bayes:
+// clusters of several members, each chosen inside its cluster by its learned weight, then descended; the other
+// samplers ignore members).
+constexpr int param_variants = 3;
 sampler_params params_variant(sampler_kind kind, int variant) {
   sampler_params p;
   p.kind = kind;
-  if (variant == 1) {
+  if (variant >= 1) {
     p.regions.max_cut = 4;
     p.regions.grid = 4;
   }
+  if (variant >= 1) p.regions.max_members = variant == 2 ? 16 : 0;
   return p;
 }
 
@@ -349,9 +353,10 @@ TEST_CASE("every light sampler satisfies the sampling contract", "[samplers]") {
     REQUIRE(pts.size() == 300);
     for (sampler_kind kind : all_kinds) {
       if (!sampler_available(kind)) continue;
-      for (int variant = 0; variant < 2; variant++) {
-        if (variant == 1 && (kind == sampler_kind::uniform || kind == sampler_kind::power || kind == sampler_kind::bvh))
+      for (int variant = 0; variant < param_variants; variant++) {
+        if (variant >= 1 && (kind == sampler_kind::uniform || kind == sampler_kind::power || kind == sampler_kind::bvh))
           continue;
+        if (variant == 2 && kind != sampler_kind::bayes) continue;  // members are the bayes sampler's only
         INFO("sampler " << sampler_name(kind) << " sun " << sun << " variant " << variant);
         light_sampler ls = make_light_sampler(params_variant(kind, variant), t->in, t->tree);
         // The bvh sampler, like pbrt-v4's, gives up when both children of a node it descended into turn out to
@@ -368,7 +373,8 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
     auto t = make_test_scene(sun);
     std::vector<shade_point> pts = shading_points(*t, 300, sun ? 3 : 4);
     for (sampler_kind kind : {sampler_kind::bound, sampler_kind::bayes}) {
-      for (int variant = 0; variant < 2; variant++) {
+      for (int variant = 0; variant < param_variants; variant++) {
+        if (variant == 2 && kind != sampler_kind::bayes) continue;
         INFO("sampler " << sampler_name(kind) << " sun " << sun << " variant " << variant);
         light_sampler ls = make_light_sampler(params_variant(kind, variant), t->in, t->tree);
         std::visit(
@@ -435,6 +441,60 @@ TEST_CASE("lazily refolded bayes weights stay within the refold tolerance of an 
     CHECK(worst <= (means ? 1 + tol : 1.0) * std::sqrt(1 + 2 * tol) - 1 + 1e-5);
     if (tol >= 0.2) CHECK(differ > 0);  // the laziness is real: some weights were not refolded
   }
+}
+
+TEST_CASE("a bayes cluster of several members weighs the sum of its members' weights after learning", "[samplers][bayes]") {
+  // Small cuts with members: clusters of several members whose weights learn apart. After every pass the cluster
+  // columns must hold exactly the in-order sums of their members' current weights (refold refreshes only the clusters
+  // of refolded pairs), and a member's probability must be its cluster's times its share of the cluster's weight.
+  auto t = make_test_scene(true);
+  light_sampler ls = make_light_sampler(params_variant(sampler_kind::bayes, 2), t->in, t->tree);
+  auto& s = std::get<bayes_sampler>(ls);
+  REQUIRE(s.regions.members);
+  int grouped = 0, learned = 0;
+  for (int round = 0; round < 4; round++) {
+    learn_passes(t->in, s, 2);
+    const region_state& r = s.regions;
+    for (size_t g = 0; g < r.key.size(); g++) {
+      int b = r.pair_offset[g], n = r.pair_count[g], c = r.cut_size[g], o = r.cut_offset[g];
+      for (int j = 0; j < c; j++) {
+        int e = j + 1 < c ? r.member_begin[size_t(o + j + 1)] : n;
+        double w = 0, w_cv = 0, cv = 0;
+        for (int k = r.member_begin[size_t(o + j)]; k < e; k++) {
+          size_t i = size_t(b + k);
+          REQUIRE(r.pair_slot[i] == o + j);
+          w += s.stats.w[i], w_cv += s.stats.w_cv[i], cv += s.stats.cv[i];
+          learned += s.stats.m[i].n0 + s.stats.m[i].n1 > 0;
+        }
+        grouped += e - r.member_begin[size_t(o + j)] > 1;
+        INFO("region " << g << " cluster " << j);
+        CHECK(s.stats.gw[size_t(o + j)] == float(w));
+        CHECK(s.stats.gw_cv[size_t(o + j)] == float(w_cv));
+        CHECK(s.stats.gcv[size_t(o + j)] == float(cv));
+      }
+    }
+  }
+  CHECK(grouped > 10);
+  CHECK(learned > 100);
+  // A member's probability at a point: its cluster's times its weight over the cluster's (no weight here is so small
+  // that the floor applies).
+  std::vector<shade_point> pts = shading_points(*t, 50, 7);
+  auto ctx = std::make_unique<cut_context>();
+  int checked = 0;
+  for (const shade_point& sp : pts) {
+    s.prepare(*ctx, sp);
+    for (int i = 0; i < 200; i++) {
+      light_choice c = s.sample(*ctx, (i + 0.5) / 200, 0.5);
+      if (c.light == invalid_id || ctx->pair_count == ctx->count) continue;
+      int j = s.group_of(*ctx, c.cluster);
+      int e = j + 1 < ctx->count ? ctx->member_begin[j + 1] : ctx->pair_count;
+      double total = 0;
+      for (int k = ctx->member_begin[j]; k < e; k++) total += ctx->member_w[k];
+      CHECK(c.cluster_prob == Approx(cluster_pmf(*ctx, j) * ctx->member_w[c.cluster] / total).epsilon(1e-12));
+      checked++;
+    }
+  }
+  CHECK(checked > 1000);
 }
 
 TEST_CASE("a scene without any light gives empty light selections", "[samplers]") {

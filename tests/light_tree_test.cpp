@@ -193,6 +193,14 @@ const set_case set_cases[] = {
     {7, 200, layout::clusters, false, "200 in clusters"},
 };
 
+// A random box of sides 2e-3..10 whose centre lies in the scene bounds grown by a quarter (and 1) on every side.
+bbox3f random_region_box(pcg32& rng, const bbox3f& bounds) {
+  vec3f grow = extent(bounds) * 0.25f + vec3f{1, 1, 1};
+  vec3f c = random_in(rng, bounds.lo - grow, bounds.hi + grow);
+  vec3f half = {log_uniform(rng, 1e-3f, 5.0f), log_uniform(rng, 1e-3f, 5.0f), log_uniform(rng, 1e-3f, 5.0f)};
+  return {c - half, c + half};
+}
+
 }  // namespace
 
 TEST_CASE("light tree structure holds its invariants on random light sets", "[light_tree]") {
@@ -494,12 +502,8 @@ TEST_CASE("a light cut partitions the lights that can reach its box", "[light_tr
     light_set s = make_light_set(sc.seed, sc.n, sc.kind, sc.two_sided);
     const light_tree_data& t = s.tree;
     pcg32 rng(sc.seed, 19);
-    bbox3f bounds = s.scene.bounds;
-    vec3f grow = extent(bounds) * 0.25f + vec3f{1, 1, 1};
     for (int k = 0; k < 60; k++) {
-      vec3f c = random_in(rng, bounds.lo - grow, bounds.hi + grow);
-      vec3f half = {log_uniform(rng, 1e-3f, 5.0f), log_uniform(rng, 1e-3f, 5.0f), log_uniform(rng, 1e-3f, 5.0f)};
-      bbox3f box = {c - half, c + half};
+      bbox3f box = random_region_box(rng, s.scene.bounds);
       region_params p;
       const int max_cuts[] = {1, 2, 8, 64};
       p.max_cut = max_cuts[k % 4];
@@ -535,6 +539,90 @@ TEST_CASE("a light cut partitions the lights that can reach its box", "[light_tr
         INFO("light " << l);
         CHECK(covered <= 1);
         if (covered == 0) CHECK(zero_bound);
+      }
+    }
+  }
+}
+
+TEST_CASE("a cut's members partition its clusters' lights that can reach the box", "[light_tree]") {
+  for (const set_case& sc : set_cases) {
+    light_set s = make_light_set(sc.seed, sc.n, sc.kind, sc.two_sided);
+    const light_tree_data& t = s.tree;
+    pcg32 rng(sc.seed, 23);
+    for (int k = 0; k < 40; k++) {
+      bbox3f box = random_region_box(rng, s.scene.bounds);
+      region_params p;
+      const int max_cuts[] = {1, 2, 8, 64};
+      p.max_cut = max_cuts[k % 4];
+      bool has_sun = k % 2 == 1;
+      std::vector<int> cut = compute_light_cut(t, box, has_sun, p);
+      const int caps[] = {0, int(cut.size()), 16, 64, 1024};
+      for (int cap : caps) {
+        INFO("set " << sc.name << " box " << k << " max_cut " << p.max_cut << " sun " << has_sun << " members " << cap);
+        std::vector<int> members, group, again, group2;
+        compute_members(t, box, cut, cap, members, group);
+        compute_members(t, box, cut, cap, again, group2);
+        CHECK(members == again);
+        CHECK(group == group2);
+        REQUIRE(members.size() == group.size());
+        CHECK(members.size() <= std::max(cut.size(), size_t(cap)));
+        CHECK(members.size() >= cut.size());
+        if (cap <= int(cut.size())) CHECK(members == cut);
+        // Sorted like the cut (sun last), clusters in cut order, each cluster at least one member that is its node
+        // or a node of its subtree.
+        for (size_t j = 0; j < members.size(); j++) {
+          REQUIRE(group[j] >= 0);
+          REQUIRE(group[j] < int(cut.size()));
+          if (j > 0) {
+            CHECK(group[j - 1] <= group[j]);
+            CHECK(group[j] - group[j - 1] <= 1);
+            if (members[j] != sun_cluster) CHECK(members[j - 1] < members[j]);
+          }
+          int g = cut[size_t(group[j])];
+          if (g == sun_cluster) {
+            CHECK(members[j] == sun_cluster);
+            CHECK(j + 1 == members.size());
+            continue;
+          }
+          REQUIRE(members[j] >= 0);
+          REQUIRE(members[j] < node_count(t));
+          bool below = false;
+          for (int m = members[j]; m != invalid_id && !below; m = t.parent[size_t(m)]) below = m == g;
+          CHECK(below);
+        }
+        if (!group.empty()) {
+          CHECK(group.front() == 0);
+          CHECK(group.back() == int(cut.size()) - 1);
+        }
+        // Every light under a tree cluster: exactly one member on its path, or none and then a node of zero bound
+        // between it and the cluster (it cannot light the box). With room for every light, members are leaves.
+        std::vector<char> is_member(size_t(node_count(t)), 0), is_cluster(size_t(node_count(t)), 0);
+        for (int m : members)
+          if (m != sun_cluster) is_member[size_t(m)] = 1;
+        for (int g : cut)
+          if (g != sun_cluster) is_cluster[size_t(g)] = 1;
+        for (int l = 0; l < s.lights.tri_count; l++) {
+          int covered = 0;
+          bool zero_bound = false, under_cluster = false;
+          for (int m = t.leaf_of_light[size_t(l)]; m != invalid_id && !under_cluster; m = t.parent[size_t(m)]) {
+            covered += is_member[size_t(m)];
+            if (node_region_bound(t, m, box.lo, box.hi) == 0) zero_bound = true;
+            under_cluster = is_cluster[size_t(m)];
+          }
+          if (!under_cluster) continue;
+          INFO("light " << l);
+          CHECK(covered <= 1);
+          if (covered == 0) CHECK(zero_bound);
+        }
+        // With room for every light, a member is a leaf, or a node kept whole because both its children have bound
+        // 0 over the box (bounds need not shrink monotonically down the tree: a node's wider cone can reach the box
+        // where neither child's does).
+        if (cap >= 1024)
+          for (int m : members)
+            if (m != sun_cluster && !is_leaf(t, m)) {
+              CHECK(node_region_bound(t, t.left[size_t(m)], box.lo, box.hi) == 0);
+              CHECK(node_region_bound(t, t.right[size_t(m)], box.lo, box.hi) == 0);
+            }
       }
     }
   }
