@@ -24,12 +24,11 @@ double point_scale(float albedo) { return double((albedo > 0 ? albedo : 1.0f) * 
 // Least receiver cosine factor of a cluster the front test keeps (it stays possible, and z = Y / factor bounded).
 constexpr float orientation_floor = 1e-3f;
 
-// The total weight of members [b, e) of a cluster, each positive weight floored at min_positive_share of their raw
-// sum (as fill_cdf does: no member that can contribute rounds to probability zero); `floor` receives that floor.
-double members_total(const float* w, int b, int e, double& floor) {
-  double raw = 0;
-  for (int k = b; k < e; k++) raw += double(w[k]);
-  floor = raw * min_positive_share;
+// The total weight of members [b, e) of a cluster, each positive weight floored at min_positive_share of `raw`,
+// the cluster's column (the sum of those weights: as fill_cdf does, no member that can contribute rounds to
+// probability zero); `floor` receives that floor.
+double members_total(const float* w, int b, int e, float raw, double& floor) {
+  floor = std::isfinite(raw) ? double(raw) * min_positive_share : 0.0;
   double total = 0;
   for (int k = b; k < e; k++)
     if (w[k] > 0) total += std::max(double(w[k]), floor);
@@ -117,6 +116,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   const bool grouped = ctx.pair_count != ctx.count;
   ctx.member_w = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
   const float* W = grouped ? (ctx.cv ? stats.gw_cv.data() : stats.gw.data()) + ctx.group_base : ctx.member_w;
+  ctx.group_w = W;
   const float* cvj = grouped ? stats.gcv.data() + ctx.group_base : stats.cv.data() + base;
   const float* mu0 = stats.mu0.data() + base;
   // The prior model's weight of cluster j at g = 1: the sum of its members' mu0.
@@ -278,7 +278,7 @@ light_choice bayes_sampler::sample_members(const context& ctx, double u, double 
     // u's place inside the cluster's cell, rescaled to the members' total weight (a cluster chosen has a positive
     // total: its weight is that sum); members of weight 0 are never chosen.
     const float* w = ctx.member_w;
-    double floor = 0, total = members_total(w, b, e, floor);
+    double floor = 0, total = members_total(w, b, e, ctx.group_w[j], floor);
     double x = (u - ctx.cdf[j]) / pj * total, run = 0;
     m = -1;
     for (int k = b; k < e; k++) {
@@ -318,7 +318,7 @@ float bayes_sampler::members_pmf(const context& ctx, int light) const {
   int b = ctx.member_begin[j], e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
   if (e - b > 1) {
     const float* w = ctx.member_w;
-    double floor = 0, total = members_total(w, b, e, floor);
+    double floor = 0, total = members_total(w, b, e, ctx.group_w[j], floor);
     p = total > 0 && w[m] > 0 ? p * (std::max(double(w[m]), floor) / total) : 0.0;
   }
   if (leaf != invalid_id) p *= intensity_descent_pmf(*tree, ctx.members[m], leaf);

@@ -84,9 +84,9 @@ int append_region(region_state& s, uint64_t key, const std::vector<int>* cut, co
     int m = s.pair_count[size_t(parent)];
     int* links = s.pair_parent.data() + s.pair_offset.back();
     // Both member lists hold ascending node ids, then possibly sun_cluster (-2) last. A member links to the parent's
-    // member of the same node, or (members refined: the parent, a coarse region, is not) of the subtree holding it:
-    // depth-first ids, so a subtree's nodes run from its root to the last leaf down its right children, and the
-    // parent's members are disjoint such ranges in ascending order.
+    // member of the same node, or with members (the coarse parent's cut may stop higher in the tree) of the subtree
+    // holding it: depth-first ids, so a subtree's nodes run from its root to the last leaf down its right children,
+    // and the parent's members are disjoint such ranges in ascending order.
     for (int j = 0, k = 0; j < n; j++) {
       if (mine[j] == sun_cluster) {
         if (m > 0 && theirs[m - 1] == sun_cluster) links[j] = s.pair_offset[size_t(parent)] + m - 1;
@@ -150,7 +150,7 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
   if (s.shared_cut) append_region(s, root_key, &all, nullptr, nullptr, invalid_id);
   else {
     std::vector<int> cut = compute_light_cut(tree, padded(b), has_sun, params);
-    append_region(s, root_key, &cut, nullptr, nullptr, invalid_id);  // the root, like coarse regions, unrefined
+    append_region(s, root_key, &cut, nullptr, nullptr, invalid_id);  // the root (a last resort) is not refined
   }
   s.root = 0;
   return s;

@@ -3,7 +3,9 @@
 // cells) and the root (the whole scene). Only regions that shading points reach exist; a point uses the
 // finest existing region containing it. Invariants: regions are created only between passes, from requests
 // in a deterministic order, so region content and ids never depend on thread timing; the root always
-// exists; the total number of (region, cluster) pairs stays under `max_pairs` (then coarser regions serve).
+// exists; the total number of (region, member) pairs stays under `max_pairs` (then coarser regions serve).
+// A region's cut lists clusters (tree nodes, then the sun); with members the clusters of fine and coarse regions
+// are refined into members (subtrees), one (region, member) pair each.
 // Keys are 64-bit (level, i, j, k) hashed with a strong mixer in an open-addressing table (load <= 1/2).
 #pragma once
 
