@@ -55,16 +55,19 @@ TEST_CASE("a scene with 100000 emissive triangles renders with every sampler", "
   double per_light = double(light_bytes(lights, tree)) / n;
   INFO("bytes per light (lights + tree): " << per_light);
   CHECK(per_light < 400);
+  // Depth 2, and direct illumination (where bayes refines its clusters into members by default).
+  for (int depth : {2, 1})
   for (sampler_kind kind : {sampler_kind::bvh, sampler_kind::bound, sampler_kind::bayes}) {
     render_params p;
     p.width = 32;
     p.height = 24;
     p.spp = 2;
-    p.max_depth = 2;
+    p.max_depth = depth;
     p.threads = 2;
     p.sampler.kind = kind;
     render_result r = render(scene, bvh, lights, p);
-    INFO(sampler_name(kind) << ": sampler state " << r.sampler_bytes << " bytes, " << r.regions << " regions");
+    INFO(sampler_name(kind) << " depth " << depth << ": sampler state " << r.sampler_bytes << " bytes, " << r.regions
+                            << " regions, " << r.pairs << " pairs");
     CHECK(r.spp == 2);
     CHECK(r.stats.bad_samples == 0);
     double sum = 0;
