@@ -2,11 +2,12 @@
 # Ablation of the bayes sampler's choices (issue 3, item 7): every switch against the defaults, at equal time, on the
 # occluded direct-only scenes, against the references tools/eqtable.sh caches in $(dirname BIN)/ref (rendered there
 # when missing). Mean relMSE over SEEDS; a ratio > 1 means the variant has that much more error than the defaults.
-#   tools/ablation.sh BIN     (env: T seconds per render, default 6; SCENES; SEEDS, default "11 22"; W, H 320x240)
+#   tools/ablation.sh BIN     (env: T seconds per render, default 6; SCENES; SEEDS, default "11 22"; W, H 320x240;
+#                              REF_SPP_DIRECT, the references' spp, default 16384 as in eqtable.sh)
 set -euo pipefail
 bin=$1
 cd "$(dirname "$0")/.."
-T=${T:-6}; W=${W:-320}; H=${H:-240}; SEEDS=${SEEDS:-"11 22"}
+T=${T:-6}; W=${W:-320}; H=${H:-240}; SEEDS=${SEEDS:-"11 22"}; REF_SPP_DIRECT=${REF_SPP_DIRECT:-16384}
 SCENES=${SCENES:-"living_room plant_room hall"}
 variants=(
   "defaults|"
@@ -25,6 +26,8 @@ variants=(
   "c 1 (prior CV 100%)|--bayes-c 1"
   "earlier defaults (a0 1, b0 1, c 1, hier. 4)|--bayes-a0 1 --bayes-b0 1 --bayes-c 1 --bayes-hierarchy 4"
   "max cut 256|--max-cut 256"
+  "no members (one per cluster)|--cut-members 0"
+  "256 members per region|--cut-members 256"
   "independent samples (no stratified first vertex)|--independent-samples"
   "bound sampler (reference point)|--sampler bound"
 )
@@ -33,8 +36,8 @@ tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 echo "ablation: direct only, ${W}x${H}, $T s per render, seeds $SEEDS; mean relMSE and ratio to the defaults"
 for scene in $SCENES; do
   json=data/$scene/direct.json
-  ref=$refdir/${scene}_direct_${W}x${H}_bayes_4096.exr
-  [ -f "$ref" ] || "$bin" render "$json" --sampler bayes --spp 4096 --seed 987654321 --width "$W" --height "$H" -o "$ref" --quiet
+  ref=$refdir/${scene}_direct_${W}x${H}_bayes_${REF_SPP_DIRECT}.exr
+  [ -f "$ref" ] || "$bin" render "$json" --sampler bayes --spp "$REF_SPP_DIRECT" --seed 987654321 --width "$W" --height "$H" -o "$ref" --quiet
   echo "  $scene"
   base=""
   for v in "${variants[@]}"; do

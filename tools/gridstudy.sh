@@ -4,17 +4,18 @@
 # the reference tools/eqtable.sh caches in $(dirname BIN)/ref (rendered there when missing; the image does not depend
 # on the grid). Mean relMSE over SEEDS; the speed-up of bayes over bound is their error ratio at equal time.
 # (A reference-free error from two seeds, used before, has a noisy denominator and mis-ranked settings.)
-#   tools/gridstudy.sh BIN     (env: T seconds per render, default 8; W, H default 320x240; GRIDS; SCENE; SEEDS)
+#   tools/gridstudy.sh BIN     (env: T seconds per render, default 8; W, H default 320x240; GRIDS; SCENE; SEEDS;
+#                               REF_SPP_DIRECT, default 16384 as in eqtable.sh)
 set -euo pipefail
 bin=$1
 cd "$(dirname "$0")/.."
-T=${T:-8}; W=${W:-320}; H=${H:-240}; SEEDS=${SEEDS:-"11 22"}
+T=${T:-8}; W=${W:-320}; H=${H:-240}; SEEDS=${SEEDS:-"11 22"}; REF_SPP_DIRECT=${REF_SPP_DIRECT:-16384}
 scene=${SCENE:-hall}
 grids=${GRIDS:-"8 16 32 64 128 256"}
 json=data/$scene/direct.json
 refdir=$(dirname "$bin")/ref; mkdir -p "$refdir"
-ref=$refdir/${scene}_direct_${W}x${H}_bayes_4096.exr
-[ -f "$ref" ] || "$bin" render "$json" --sampler bayes --spp 4096 --seed 987654321 --width "$W" --height "$H" -o "$ref" --quiet
+ref=$refdir/${scene}_direct_${W}x${H}_bayes_${REF_SPP_DIRECT}.exr
+[ -f "$ref" ] || "$bin" render "$json" --sampler bayes --spp "$REF_SPP_DIRECT" --seed 987654321 --width "$W" --height "$H" -o "$ref" --quiet
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 err() {  # mean relMSE over the seeds of one configuration
   local sum=0 n=0
