@@ -7,6 +7,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <string>
+#include <utility>
+#include <vector>
+
 using namespace bl;
 using namespace bl::test;
 
@@ -24,9 +28,13 @@ std::string render_args(const std::string& sampler, const std::string& extra) {
 
 TEST_CASE("one and two threads give byte identical files for every sampler", "[determinism]") {
   temp_dir d;
-  for (const char* s : samplers) {
-    std::string a = d / (std::string(s) + "_1.exr"), b = d / (std::string(s) + "_2.exr");
-    std::string pa = d / (std::string(s) + "_1.pfm"), pb = d / (std::string(s) + "_2.pfm");
+  // Every sampler, and bayes in direct illumination too (where its clusters are refined into members).
+  std::vector<std::pair<std::string, std::string>> runs;  // (file label, sampler and options)
+  for (const char* s : samplers) runs.push_back({s, s});
+  runs.push_back({"bayes_direct", "bayes --max-depth 1"});
+  for (const auto& [label, s] : runs) {
+    std::string a = d / (label + "_1.exr"), b = d / (label + "_2.exr");
+    std::string pa = d / (label + "_1.pfm"), pb = d / (label + "_2.pfm");
     auto r1 = run_bayeslight(render_args(s, "--spp 6 --threads 1 -o " + a + " -o " + pa));
     auto r2 = run_bayeslight(render_args(s, "--spp 6 --threads 2 -o " + b + " -o " + pb));
     INFO(s << "\n" << r1.output << r2.output);
