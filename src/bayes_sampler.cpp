@@ -305,12 +305,7 @@ float bayes_sampler::members_pmf(const context& ctx, int light) const {
     m = ctx.pair_count - 1;
   } else {
     leaf = tree->leaf_of_light[size_t(light)];
-    const int* begin = ctx.members;
-    const int* end = ctx.members + ctx.pair_count - (ctx.tree_count < ctx.count ? 1 : 0);
-    for (int n = leaf; n != invalid_id && m < 0; n = tree->parent[size_t(n)]) {
-      const int* it = std::lower_bound(begin, end, n);
-      if (it != end && *it == n) m = int(it - begin);
-    }
+    m = holding_entry(*tree, leaf, ctx.members, ctx.members + ctx.pair_count - (ctx.tree_count < ctx.count ? 1 : 0));
     if (m < 0) return 0;  // the light's subtree was left out of the cut: it cannot reach this region
   }
   int j = group_of(ctx, m);

@@ -55,16 +55,17 @@ float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_d
   if (light == lights.sun)
     return ctx.nodes[ctx.count - 1] == sun_cluster ? float(cluster_pmf(ctx, ctx.count - 1)) : 0.0f;
   int leaf = tree.leaf_of_light[size_t(light)];
-  const int* begin = ctx.nodes;
-  const int* end = ctx.nodes + ctx.tree_count;
+  int j = holding_entry(tree, leaf, ctx.nodes, ctx.nodes + ctx.tree_count);
+  if (j < 0) return 0;  // the light's subtree was left out of the cut: it cannot reach this region
+  return float(cluster_pmf(ctx, j) * intensity_descent_pmf(tree, ctx.nodes[j], leaf));
+}
+
+int holding_entry(const light_tree_data& tree, int leaf, const int* begin, const int* end) {
   for (int n = leaf; n != invalid_id; n = tree.parent[size_t(n)]) {
     const int* it = std::lower_bound(begin, end, n);
-    if (it != end && *it == n) {
-      int j = int(it - begin);
-      return float(cluster_pmf(ctx, j) * intensity_descent_pmf(tree, n, leaf));
-    }
+    if (it != end && *it == n) return int(it - begin);
   }
-  return 0;  // the light's subtree was left out of the cut: it cannot reach this region
+  return -1;
 }
 
 int create_requested_regions(region_state& regions, const light_tree_data& tree,

@@ -89,6 +89,8 @@ inline double cluster_pmf(const cut_context& ctx, int j) { return ctx.cdf[j + 1]
 // Picks a cluster with u and a light inside it with u_inner.
 light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, double u,
                         double u_inner);
+// Index in the sorted node list [begin, end) of the node holding `leaf` (itself or an ancestor), or -1.
+int holding_entry(const light_tree_data& tree, int leaf, const int* begin, const int* end);
 // Probability that sample_cut picks `light`.
 float cut_pmf(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, int light);
 
