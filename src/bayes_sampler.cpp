@@ -24,13 +24,13 @@ double point_scale(float albedo) { return double((albedo > 0 ? albedo : 1.0f) * 
 // Least receiver cosine factor of a cluster the front test keeps (it stays possible, and z = Y / factor bounded).
 constexpr float orientation_floor = 1e-3f;
 
-// The total weight of members [b, e) of a cluster, each positive weight floored at min_positive_share of `raw`,
-// the cluster's column (the sum of those weights: as fill_cdf does, no member that can contribute rounds to
-// probability zero); `floor` receives that floor.
-double members_total(const float* w, int b, int e, float raw, double& floor) {
-  floor = std::isfinite(raw) ? double(raw) * min_positive_share : 0.0;
+// The floor of a cluster's positive member weights: min_positive_share of `raw`, the cluster's column (the sum of
+// those weights), so that, as in fill_cdf, no member that can contribute rounds to probability zero.
+double member_floor(float raw) { return std::isfinite(raw) ? double(raw) * min_positive_share : 0.0; }
+// The total weight of the n members w[0..n) of a cluster, each positive weight floored at `floor`.
+double members_total(const float* w, int n, double floor) {
   double total = 0;
-  for (int k = b; k < e; k++)
+  for (int k = 0; k < n; k++)
     if (w[k] > 0) total += std::max(double(w[k]), floor);
   return total;
 }
@@ -117,6 +117,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   ctx.member_w = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
   const float* W = grouped ? (ctx.cv ? stats.gw_cv.data() : stats.gw.data()) + ctx.group_base : ctx.member_w;
   ctx.group_w = W;
+  ctx.group_total = grouped ? (ctx.cv ? stats.gtot_cv.data() : stats.gtot.data()) + ctx.group_base : nullptr;
   const float* cvj = grouped ? stats.gcv.data() + ctx.group_base : stats.cv.data() + base;
   const float* mu0 = stats.mu0.data() + base;
   // The prior model's weight of cluster j at g = 1: the sum of its members' mu0.
@@ -127,14 +128,8 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     for (int k = ctx.member_begin[j]; k < e; k++) m += double(mu0[k]);
     return m;
   };
-  // Adds colour_m c_m of cluster j's members (c_m = cv_m g_j) to cv_sum, in member order.
-  auto add_members_cv = [&](vec3f& sum, int j, float g) {
-    int e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
-    for (int k = ctx.member_begin[j]; k < e; k++) {
-      float c = stats.cv[base + size_t(k)] * g;
-      if (c != 0) sum += cluster_color(ctx, k) * c;
-    }
-  };
+  // sum_m colour_m cv_m of each cluster (its members' c_m = cv_m g_j share the factor g_j).
+  const vec3f* gcol = grouped ? stats.gcol.data() + ctx.group_base : nullptr;
   alignas(16) float wf[max_cut_entries + 3];
   float* gf = ctx.gfac;
   const int tc = ctx.tree_count;
@@ -180,7 +175,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
       _mm_storeu_ps(ctx.cvg + j0, c);
       for (int m = _mm_movemask_ps(_mm_cmpneq_ps(c, zero)) & lanes; m != 0; m &= m - 1) {
         int j = j0 + __builtin_ctz(unsigned(m));
-        if (grouped) add_members_cv(cv_sum, j, gf[j]);
+        if (grouped) cv_sum += gcol[j] * gf[j];
         else cv_sum += cluster_color(ctx, j) * ctx.cvg[j];
       }
     }
@@ -278,7 +273,7 @@ light_choice bayes_sampler::sample_members(const context& ctx, double u, double 
     // u's place inside the cluster's cell, rescaled to the members' total weight (a cluster chosen has a positive
     // total: its weight is that sum); members of weight 0 are never chosen.
     const float* w = ctx.member_w;
-    double floor = 0, total = members_total(w, b, e, ctx.group_w[j], floor);
+    double floor = member_floor(ctx.group_w[j]), total = ctx.group_total[j];
     double x = (u - ctx.cdf[j]) / pj * total, run = 0;
     m = -1;
     for (int k = b; k < e; k++) {
@@ -313,7 +308,7 @@ float bayes_sampler::members_pmf(const context& ctx, int light) const {
   int b = ctx.member_begin[j], e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
   if (e - b > 1) {
     const float* w = ctx.member_w;
-    double floor = 0, total = members_total(w, b, e, ctx.group_w[j], floor);
+    double floor = member_floor(ctx.group_w[j]), total = ctx.group_total[j];
     p = total > 0 && w[m] > 0 ? p * (std::max(double(w[m]), floor) / total) : 0.0;
   }
   if (leaf != invalid_id) p *= intensity_descent_pmf(*tree, ctx.members[m], leaf);
@@ -326,16 +321,29 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs) {
   stats.gw.resize(slots + 4, 0.0f);
   stats.gw_cv.resize(slots + 4, 0.0f);
   stats.gcv.resize(slots + 4, 0.0f);
+  stats.gcol.resize(slots, vec3f{0, 0, 0});
+  stats.gtot.resize(slots, 0.0);
+  stats.gtot_cv.resize(slots, 0.0);
   const std::vector<int>& slot = regions.pair_slot;
   size_t npairs = slot.size();
   // The sums of the run of pairs of one cluster starting at `first` (a cluster's members are consecutive pairs).
   auto sum_run = [&](size_t first) {
     int g = slot[first];
-    double a = 0, b = 0, c = 0;
-    for (size_t k = first; k < npairs && slot[k] == g; k++) a += stats.w[k], b += stats.w_cv[k], c += stats.cv[k];
+    double a = 0, b = 0, c = 0, r = 0, gr = 0, bl = 0;
+    size_t k = first;
+    for (; k < npairs && slot[k] == g; k++) {
+      a += stats.w[k], b += stats.w_cv[k], c += stats.cv[k];
+      int node = regions.pair_node[k];
+      vec3f col = node == sun_cluster ? sun_color : tree->color[size_t(node)];
+      r += double(col.x) * stats.cv[k], gr += double(col.y) * stats.cv[k], bl += double(col.z) * stats.cv[k];
+    }
     stats.gw[size_t(g)] = float(a);
     stats.gw_cv[size_t(g)] = float(b);
     stats.gcv[size_t(g)] = float(c);
+    stats.gcol[size_t(g)] = {float(r), float(gr), float(bl)};
+    int n = int(k - first);
+    stats.gtot[size_t(g)] = members_total(stats.w.data() + first, n, member_floor(stats.gw[size_t(g)]));
+    stats.gtot_cv[size_t(g)] = members_total(stats.w_cv.data() + first, n, member_floor(stats.gw_cv[size_t(g)]));
   };
   if (!pairs) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, regions.key.size(), 256), [&](const tbb::blocked_range<size_t>& r) {

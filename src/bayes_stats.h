@@ -109,6 +109,10 @@ struct bayes_stats {
                                          // last examined for it
   std::vector<float> gw, gw_cv, gcv;     // members (region_state::members), per cut entry: the sums of its members'
                                          // w, w_cv and cv (+ 4 padding each), what a point weighs the cluster by
+  std::vector<double> gtot, gtot_cv;     // members, per cut entry: the total a member is chosen from inside the cluster
+                                         // (its members' positive w, resp. w_cv, each floored at a tiny share of gw)
+  std::vector<vec3f> gcol;               // members, per cut entry: the sum of its members' colour times cv (a point's
+                                         // control-variate total adds it times the cluster's point factor)
   merge_buffers scratch;
 };
 

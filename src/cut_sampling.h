@@ -38,6 +38,7 @@ struct cut_context {
   int group_base = 0;
   const float* member_w = nullptr;  // bayes: the members' weight column a point chose from (inside a cluster)
   const float* group_w = nullptr;   // bayes: the clusters' column it weighed them by (their members' summed weights)
+  const double* group_total = nullptr;  // bayes: per cluster, the members' total a member is chosen from
   double cdf[max_cut_entries + 1];
   // Control variates (bayes): whether they apply at this point, sum_j colour_j c_j and c_j per cluster, with c_j
   // the learned mean of cluster j's albedo-free sample (the integrator scales by (kd + ks) / pi).
