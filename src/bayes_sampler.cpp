@@ -24,6 +24,22 @@ double point_scale(float albedo) { return double((albedo > 0 ? albedo : 1.0f) * 
 // Least receiver cosine factor of a cluster the front test keeps (it stays possible, and z = Y / factor bounded).
 constexpr float orientation_floor = 1e-3f;
 
+// The Phong lobe's factor of a glossy point toward a bounding sphere seen at cosine cos_a from the mirror direction
+// with angular radius asin(sin_t): gloss_base + gloss_peak times the lobe's largest value over the sphere's directions,
+// at least orientation_floor (a cluster the front test keeps stays possible, and z = Y / factor bounded). Below
+// cos_min the lobe's term is negligible (under 1e-6 of the albedo scale) and left out.
+float gloss_factor(const shade_point& sp, float cos_min, float cos_a, float sin_t) {
+  float lobe = 0;
+  if (sin_t >= 1) {
+    lobe = 1;  // the point is inside the sphere
+  } else {
+    float cos_t = std::sqrt(1 - sin_t * sin_t);
+    float c = cos_a >= cos_t ? 1.0f : cos_a * cos_t + std::sqrt(std::max(0.0f, 1 - cos_a * cos_a)) * sin_t;
+    if (c > cos_min) lobe = std::pow(c, sp.ns);
+  }
+  return std::max(sp.gloss_base + sp.gloss_peak * lobe, orientation_floor);
+}
+
 // The floor of a cluster's positive member weights: min_positive_share of `raw`, the cluster's column (the sum of
 // those weights), so that, as in fill_cdf, no member that can contribute rounds to probability zero.
 double member_floor(float raw) { return std::isfinite(raw) ? double(raw) * min_positive_share : 0.0; }
@@ -41,6 +57,7 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   ctx.cv = false;
   if (fallback) return;  // power sampling: no region, no weights
   locate_region(ctx, regions, sp);
+  ctx.count = ctx.cut_count, ctx.tree_count = ctx.cut_tree_count, ctx.nodes = ctx.cut_nodes;
   if (ctx.pair_count == 1) {
     // One cluster of one member: its probability is 1 whatever was learned (and nothing is recorded for it).
     ctx.cdf[0] = 0;
@@ -113,6 +130,16 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   // members at the point is their cv times the cluster's factor g; the member is chosen in sample_members.
   size_t base = size_t(ctx.pair_base);
   ctx.cv = params.control_variate && sp.last;
+  const bool gloss = params.bsdf_factor && sp.gloss_peak > 0;
+  if (gloss && ctx.pair_count != ctx.count && ctx.pair_count <= max_cut_entries) {
+    // A glossy point weighs every member as its own cluster (with its own lobe factor): which lights a highlight
+    // mirrors changes faster across a region than the members' region-wide weights can follow.
+    ctx.tree_count = ctx.pair_count - (ctx.cut_tree_count < ctx.cut_count ? 1 : 0);
+    ctx.count = ctx.pair_count;
+    ctx.nodes = ctx.members;
+  }
+  // Lobe values below cos_min^ns add under 1e-6 of the albedo scale (gloss_factor leaves them out).
+  const float cos_min = gloss ? (sp.gloss_peak > 1e-6f ? std::pow(1e-6f / sp.gloss_peak, 1 / sp.ns) : 1.0f) : 1.0f;
   const bool grouped = ctx.pair_count != ctx.count;
   ctx.member_w = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
   const float* W = grouped ? (ctx.cv ? stats.gw_cv.data() : stats.gw.data()) + ctx.group_base : ctx.member_w;
@@ -163,6 +190,17 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
       __m128 c = _mm_div_ps(_mm_sub_ps(c3, dn), _mm_max_ps(_mm_sqrt_ps(d2), tiny));
       g = _mm_mul_ps(g, _mm_min_ps(one, _mm_max_ps(c, orient_floor)));
     }
+    if (gloss) {
+      // The lobe's factor toward each of the four spheres (centre at -(dx, dy, dz) from the point, radius c3).
+      alignas(16) float ax[4], ay[4], az[4], dd[4], rr[4], fac[4];
+      _mm_store_ps(ax, dx), _mm_store_ps(ay, dy), _mm_store_ps(az, dz), _mm_store_ps(dd, d2), _mm_store_ps(rr, c3);
+      for (int k = 0; k < 4; k++) {
+        float d = std::sqrt(dd[k]);
+        float cos_a = d > 0 ? -(sp.refl.x * ax[k] + sp.refl.y * ay[k] + sp.refl.z * az[k]) / d : 1.0f;
+        fac[k] = gloss_factor(sp, cos_min, cos_a, d > rr[k] ? rr[k] / d : 1.0f);
+      }
+      g = _mm_mul_ps(g, _mm_load_ps(fac));
+    }
     g = _mm_and_ps(front, g);
     _mm_storeu_ps(gf + j0, g);
     _mm_store_ps(wf + j0, _mm_mul_ps(_mm_loadu_ps(W + j0), g));
@@ -184,6 +222,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     float front = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
     float cos_bound = orientation ? receiver_cos_bound(sp.n, lights->sun_dir, sun_sin, sun_cos) : 1.0f;
     gf[tc] = front * std::min(1.0f, std::max(cos_bound, orientation_floor));
+    if (gloss) gf[tc] *= gloss_factor(sp, cos_min, dot(sp.refl, lights->sun_dir), sun_sin);
     wf[tc] = W[tc] * gf[tc];
     front_mask |= gf[tc] > 0;
     if (ctx.cv) {

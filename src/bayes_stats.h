@@ -39,6 +39,10 @@ struct bayes_params {
   double refold_tolerance = 0.05;  // hierarchy: a coarse pair's children are refolded when its p1 has moved by more
                                    // than this fraction (of max(p1, 0.1)) since their last fold (a child's p1 moves
                                    // by at most that fraction too); 0: whenever it changes at all
+  bool bsdf_factor = true;       // region prior: at a glossy point the factor also holds the Phong lobe's largest
+                                 // value toward the cluster's bounding sphere (over the albedo scale), and a region
+                                 // with members is weighed member by member there (a highlight is sharper than a
+                                 // region: which lights it mirrors changes across the region)
   bool orientation = true;       // region prior: the point factor of a cluster is its receiver cosine bound / d^2
                                  // (z = Y d^2 / cos), not 1 / d^2 alone: the regression also learns what the
                                  // orientation of the point explains

@@ -277,7 +277,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
   h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
   h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
-  h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified);
+  h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
   const donikian_params& d = p.sampler.donikian;
   h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
   return h.h;

@@ -32,6 +32,7 @@ void locate_region(cut_context& ctx, const region_state& regions, const shade_po
     ctx.members = regions.pair_node.data() + e->pair_offset;
     ctx.member_begin = regions.member_begin.data() + e->cut_offset;
     ctx.group_base = e->cut_offset;
+    ctx.cut_count = ctx.count, ctx.cut_tree_count = ctx.tree_count, ctx.cut_nodes = ctx.nodes;
   }
 }
 

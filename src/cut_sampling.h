@@ -30,6 +30,10 @@ struct cut_context {
   int count = 0;               // clusters in the cut
   int tree_count = 0;          // of which tree nodes (the sun, if any, is last)
   const int* nodes = nullptr;  // the cut's node ids
+  // The region's cut as located (bayes may weigh a point over the members instead: count, tree_count and nodes then
+  // describe the members, each its own cluster, for that point only).
+  int cut_count = 0, cut_tree_count = 0;
+  const int* cut_nodes = nullptr;
   // Members (region_state): the region's member count (= pairs), their nodes, each cluster's first member, and
   // the cut's first column index (the region's cut_offset: group columns are indexed by it plus the cluster).
   int pair_count = 0;

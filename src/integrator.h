@@ -177,7 +177,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     if (depth == 1 && in.stratify)
       stratify_with(ps.strata, uint32_t(sample - in.stratum_base), last, r);
     typename Sampler::context& ctx = ctxs[depth & 1];
-    shade_point spt{sp.p, sp.ng, luminance(bsdf.kd) + luminance(bsdf.ks), pixel, depth, last};
+    shade_point spt = make_shade_point(sp.p, bsdf, wo, pixel, depth, last);
     tm.stop(prof_shading, t0);
     if constexpr (Timers::enabled) {
       // Profiles time the region lookup apart; prepare() then finds it cached.

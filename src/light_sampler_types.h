@@ -50,6 +50,10 @@ struct shade_point {
   int pixel = 0;     // image pixel of the path
   int depth = 1;     // 1 = first hit
   bool last = false; // the path ends here: NEE is unweighted (no MIS), so a control variate may be applied
+  // A glossy point (Phong lobe; bayes's point factor): wo mirrored about the shading normal, the exponent, and the
+  // BSDF over the albedo scale (kd + ks) / pi as gloss_base + gloss_peak cos^ns, cos toward refl (gloss_peak 0: none).
+  vec3f refl = {0, 0, 1};
+  float ns = 1, gloss_base = 1, gloss_peak = 0;
 };
 
 // A chosen light with its selection probability; cluster is the sampler's own bookkeeping (or -1).

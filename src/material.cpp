@@ -7,13 +7,6 @@
 
 namespace bl {
 
-namespace {
-
-// wo mirrored about n.
-vec3f reflect(vec3f wo, vec3f n) { return n * (2 * dot(wo, n)) - wo; }
-
-}  // namespace
-
 bsdf_data make_bsdf(const scene_data& scene, const surface_point& sp) {
   const material_data& m = scene.mesh.materials[sp.material];
   bsdf_data b;

@@ -5,6 +5,7 @@
 // down otherwise) so no material creates energy.
 #pragma once
 
+#include "light_sampler_types.h"
 #include "math.h"
 #include "scene.h"
 
@@ -18,6 +19,23 @@ struct bsdf_data {
   frame3f frame;      // shading frame about sp.ns
   vec3f ng;           // geometric normal on the wo side
 };
+
+// wo mirrored about n (the Phong lobe's axis).
+inline vec3f reflect(vec3f wo, vec3f n) { return n * (2 * dot(wo, n)) - wo; }
+
+// What a light sampler sees of a shading point with BSDF b and outgoing direction wo: position, geometric normal, the
+// albedo scale, and for a Phong lobe its mirror direction and shares (shade_point).
+inline shade_point make_shade_point(vec3f p, const bsdf_data& b, vec3f wo, int pixel, int depth, bool last) {
+  float lum_kd = luminance(b.kd), lum_ks = luminance(b.ks);
+  shade_point s{p, b.ng, lum_kd + lum_ks, pixel, depth, last};
+  if (b.spec_prob > 0 && lum_ks > 0) {
+    s.refl = reflect(wo, b.frame.n);
+    s.ns = b.ns;
+    s.gloss_base = lum_kd / s.albedo;
+    s.gloss_peak = lum_ks * (b.ns + 2) * 0.5f / s.albedo;
+  }
+  return s;
+}
 
 // The BSDF at sp.
 bsdf_data make_bsdf(const scene_data& scene, const surface_point& sp);

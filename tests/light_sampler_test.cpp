@@ -117,10 +117,10 @@ std::vector<shade_point> shading_points(const test_scene& t, int count, uint64_t
     hit_info h = intersect(t.bvh, org, dir);
     if (h.tri == invalid_id) continue;
     surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, dir);
-    const material_data& m = t.scene.mesh.materials[size_t(sp.material)];
-    // Pixels cycle through the image (samplers that learn per pixel index their tables with them).
+    // Pixels cycle through the image (samplers that learn per pixel index their tables with them). The wall's
+    // Phong lobe makes some points glossy (bayes weighs their clusters with the lobe, members one by one).
     int pixel = int(out.size()) % (t.in.camera.width * t.in.camera.height);
-    out.push_back(shade_point{sp.p, sp.ng, luminance(m.kd) + luminance(m.ks), pixel, 1 + tries % 2});
+    out.push_back(make_shade_point(sp.p, make_bsdf(t.scene, sp), -dir, pixel, 1 + tries % 2, false));
   }
   return out;
 }
@@ -351,6 +351,7 @@ TEST_CASE("every light sampler satisfies the sampling contract", "[samplers]") {
     auto t = make_test_scene(sun);
     std::vector<shade_point> pts = shading_points(*t, 300, sun ? 1 : 2);
     REQUIRE(pts.size() == 300);
+    CHECK(std::count_if(pts.begin(), pts.end(), [](const shade_point& p) { return p.gloss_peak > 0; }) >= 30);
     for (sampler_kind kind : all_kinds) {
       if (!sampler_available(kind)) continue;
       for (int variant = 0; variant < param_variants; variant++) {
