@@ -18,32 +18,37 @@ namespace {
 
 const char* samplers[] = {"uniform", "power", "bvh", "bound", "donikian", "bayes"};
 
-// A small render of a data/ scene with occlusion, a sun and textures (the living room, path traced).
-std::string render_args(const std::string& sampler, const std::string& extra) {
-  return "render " + source_path("data/living_room/path.json") + " --width 40 --height 30 --sampler " + sampler +
-         " --quiet " + extra;
+// A small render of a data/ scene: by default one with occlusion, a sun and textures (the living room, path traced).
+std::string render_args(const std::string& sampler, const std::string& extra,
+                        const std::string& scene = "data/living_room/path.json") {
+  return "render " + source_path(scene) + " --width 40 --height 30 --sampler " + sampler + " --quiet " + extra;
 }
 
 }  // namespace
 
 TEST_CASE("one and two threads give byte identical files for every sampler", "[determinism]") {
   temp_dir d;
-  // Every sampler, and bayes in direct illumination too (where its clusters are refined into members).
-  std::vector<std::pair<std::string, std::string>> runs;  // (file label, sampler and options)
-  for (const char* s : samplers) runs.push_back({s, s});
-  runs.push_back({"bayes_direct", "bayes --max-depth 1"});
-  for (const auto& [label, s] : runs) {
+  // Every sampler, and bayes in direct illumination too (where its clusters are refined into members), also in the
+  // plant room (a glossy statue: its points weigh members one by one with the Phong lobe).
+  struct run {
+    std::string label, sampler, scene;
+  };
+  std::vector<run> runs;
+  for (const char* s : samplers) runs.push_back({s, s, "data/living_room/path.json"});
+  runs.push_back({"bayes_direct", "bayes --max-depth 1", "data/living_room/path.json"});
+  runs.push_back({"bayes_glossy", "bayes", "data/plant_room/direct.json"});
+  for (const auto& [label, s, scene] : runs) {
     std::string a = d / (label + "_1.exr"), b = d / (label + "_2.exr");
     std::string pa = d / (label + "_1.pfm"), pb = d / (label + "_2.pfm");
-    auto r1 = run_bayeslight(render_args(s, "--spp 6 --threads 1 -o " + a + " -o " + pa));
-    auto r2 = run_bayeslight(render_args(s, "--spp 6 --threads 2 -o " + b + " -o " + pb));
+    auto r1 = run_bayeslight(render_args(s, "--spp 6 --threads 1 -o " + a + " -o " + pa, scene));
+    auto r2 = run_bayeslight(render_args(s, "--spp 6 --threads 2 -o " + b + " -o " + pb, scene));
     INFO(s << "\n" << r1.output << r2.output);
     REQUIRE(r1.status == 0);
     REQUIRE(r2.status == 0);
     CHECK(read_file(a) == read_file(b));
     CHECK(read_file(pa) == read_file(pb));
     // A re-run with the same options is identical too.
-    auto r3 = run_bayeslight(render_args(s, "--spp 6 --threads 2 -o " + a));
+    auto r3 = run_bayeslight(render_args(s, "--spp 6 --threads 2 -o " + a, scene));
     REQUIRE(r3.status == 0);
     CHECK(read_file(a) == read_file(b));
   }

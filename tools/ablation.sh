@@ -13,6 +13,7 @@ variants=(
   "defaults|"
   "point prior (bound at every point)|--bayes-prior point"
   "no orientation factor (1/d^2 only)|--bayes-no-orientation"
+  "no BSDF factor (glossy points weighed as diffuse)|--bayes-no-bsdf-factor"
   "equal pass weights|--pass-weighting 0"
   "no control variates|--bayes-no-cv"
   "mean PMF (no second moment)|--bayes-pmf mean"
