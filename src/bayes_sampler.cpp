@@ -127,7 +127,9 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   // light of it can give a non-zero sample (the BSDF is zero below the geometric tangent plane). Four tree
   // clusters at a time; the sun (last, if any) is zero when its whole disk is below the tangent plane.
   // With members (a cluster of several), a cluster weighs the sum of its members' W (gw, gw_cv) and c_j of its
-  // members at the point is their cv times the cluster's factor g; the member is chosen in sample_members.
+  // members at the point is their cv times the cluster's factor g; the member is chosen in sample_members. A glossy
+  // point multiplies g by the lobe's factor (gloss_factor), and where the region has members weighs them instead of
+  // its clusters, each as a cluster of its own.
   size_t base = size_t(ctx.pair_base);
   ctx.cv = params.control_variate && sp.last;
   const bool gloss = params.bsdf_factor && sp.gloss_peak > 0;

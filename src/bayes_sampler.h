@@ -54,8 +54,9 @@ struct bayes_sampler {
     if (!fallback) locate_region(ctx, regions, sp);
   }
   void prepare(context& ctx, const shade_point& sp) const;
-  // Region-prior mode's weights at a point (prepare's fast path): W of each pair times 1 / d^2, zero for clusters
-  // entirely behind the point's surface.
+  // Region-prior mode's weights at a point (prepare's fast path): W of each pair times its point factor (1 / d^2, the
+  // receiver's cosine bound, and at a glossy point the Phong lobe's bound: over the members where the region has
+  // them), zero for clusters entirely behind the point's surface.
   void prepare_region_prior(context& ctx, const shade_point& sp) const;
   // A cluster by the point's cdf, then (a cluster of several members) a member by its weight, the cluster's share
   // of u rescaled to [0, 1) choosing it (so a stratified u stays stratified inside the cluster), then a light of the
