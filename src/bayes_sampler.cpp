@@ -24,20 +24,26 @@ double point_scale(float albedo) { return double((albedo > 0 ? albedo : 1.0f) * 
 // Least receiver cosine factor of a cluster the front test keeps (it stays possible, and z = Y / factor bounded).
 constexpr float orientation_floor = 1e-3f;
 
-// The Phong lobe's factor of a glossy point toward a bounding sphere seen at cosine cos_a from the mirror direction
-// with angular radius asin(sin_t): gloss_base + gloss_peak times the lobe's largest value over the sphere's directions,
-// at least orientation_floor (a cluster the front test keeps stays possible, and z = Y / factor bounded). Below
-// cos_min the lobe's term is negligible (under 1e-6 of the albedo scale) and left out.
-float gloss_factor(const shade_point& sp, float cos_min, float cos_a, float sin_t) {
-  float lobe = 0;
-  if (sin_t >= 1) {
-    lobe = 1;  // the point is inside the sphere
-  } else {
-    float cos_t = std::sqrt(1 - sin_t * sin_t);
-    float c = cos_a >= cos_t ? 1.0f : cos_a * cos_t + std::sqrt(std::max(0.0f, 1 - cos_a * cos_a)) * sin_t;
-    if (c > cos_min) lobe = std::pow(c, sp.ns);
-  }
-  return std::max(sp.gloss_base + sp.gloss_peak * lobe, orientation_floor);
+// The Phong lobe's factor of a glossy point toward four bounding spheres, each seen at cosine cos_a from the mirror
+// direction with angular radius asin(sin_t) (sin_t >= 1: the point is inside): gloss_base + gloss_peak times a bound
+// of the lobe's largest value over the sphere's directions, at least orientation_floor (a cluster the front test keeps
+// stays possible, and z = Y / factor bounded). With c the largest cosine to the mirror direction over the sphere,
+// c^n <= exp(-n (1 - c)) <= (1 + n (1 - c) / 256)^-256: eight squarings and a division, no pow (a few per cent looser
+// than c^n where the lobe matters, 1.6x at 0.1 below its peak when n = 100).
+__m128 gloss_factor4(const shade_point& sp, __m128 cos_a, __m128 sin_t) {
+  const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
+  __m128 inside = _mm_cmpge_ps(sin_t, one);
+  sin_t = _mm_min_ps(sin_t, one);
+  __m128 cos_t = _mm_sqrt_ps(_mm_max_ps(zero, _mm_sub_ps(one, _mm_mul_ps(sin_t, sin_t))));
+  __m128 sin_a = _mm_sqrt_ps(_mm_max_ps(zero, _mm_sub_ps(one, _mm_mul_ps(cos_a, cos_a))));
+  __m128 c = _mm_add_ps(_mm_mul_ps(cos_a, cos_t), _mm_mul_ps(sin_a, sin_t));  // cos(angle - radius)
+  __m128 full = _mm_or_ps(inside, _mm_cmpge_ps(cos_a, cos_t));                 // the mirror direction hits the sphere
+  c = _mm_or_ps(_mm_and_ps(full, one), _mm_andnot_ps(full, _mm_min_ps(c, one)));
+  __m128 t = _mm_add_ps(one, _mm_mul_ps(_mm_set1_ps(sp.ns * (1.0f / 256)), _mm_sub_ps(one, c)));
+  for (int k = 0; k < 8; k++) t = _mm_mul_ps(t, t);  // t^256 (inf far off the lobe: the bound is then 0)
+  __m128 lobe = _mm_div_ps(one, t);
+  __m128 f = _mm_add_ps(_mm_set1_ps(sp.gloss_base), _mm_mul_ps(_mm_set1_ps(sp.gloss_peak), lobe));
+  return _mm_max_ps(f, _mm_set1_ps(orientation_floor));
 }
 
 // The floor of a cluster's positive member weights: min_positive_share of `raw`, the cluster's column (the sum of
@@ -128,7 +134,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   // clusters at a time; the sun (last, if any) is zero when its whole disk is below the tangent plane.
   // With members (a cluster of several), a cluster weighs the sum of its members' W (gw, gw_cv) and c_j of its
   // members at the point is their cv times the cluster's factor g; the member is chosen in sample_members. A glossy
-  // point multiplies g by the lobe's factor (gloss_factor), and where the region has members weighs them instead of
+  // point multiplies g by the lobe's factor (gloss_factor4), and where the region has members weighs them instead of
   // its clusters, each as a cluster of its own.
   size_t base = size_t(ctx.pair_base);
   ctx.cv = params.control_variate && sp.last;
@@ -140,8 +146,6 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     ctx.count = ctx.pair_count;
     ctx.nodes = ctx.members;
   }
-  // Lobe values below cos_min^ns add under 1e-6 of the albedo scale (gloss_factor leaves them out).
-  const float cos_min = gloss ? (sp.gloss_peak > 1e-6f ? std::pow(1e-6f / sp.gloss_peak, 1 / sp.ns) : 1.0f) : 1.0f;
   const bool grouped = ctx.pair_count != ctx.count;
   ctx.member_w = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
   const float* W = grouped ? (ctx.cv ? stats.gw_cv.data() : stats.gw.data()) + ctx.group_base : ctx.member_w;
@@ -164,6 +168,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   const int tc = ctx.tree_count;
   const __m128 px = _mm_set1_ps(sp.p.x), py = _mm_set1_ps(sp.p.y), pz = _mm_set1_ps(sp.p.z);
   const __m128 nx = _mm_set1_ps(sp.n.x), ny = _mm_set1_ps(sp.n.y), nz = _mm_set1_ps(sp.n.z);
+  const __m128 rx = _mm_set1_ps(sp.refl.x), ry = _mm_set1_ps(sp.refl.y), rz = _mm_set1_ps(sp.refl.z);
   const __m128 one = _mm_set1_ps(1.0f), slack = _mm_set1_ps(1e-5f);
   const __m128 orient_floor = _mm_set1_ps(orientation_floor), tiny = _mm_set1_ps(1e-30f);
   const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
@@ -193,15 +198,12 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
       g = _mm_mul_ps(g, _mm_min_ps(one, _mm_max_ps(c, orient_floor)));
     }
     if (gloss) {
-      // The lobe's factor toward each of the four spheres (centre at -(dx, dy, dz) from the point, radius c3).
-      alignas(16) float ax[4], ay[4], az[4], dd[4], rr[4], fac[4];
-      _mm_store_ps(ax, dx), _mm_store_ps(ay, dy), _mm_store_ps(az, dz), _mm_store_ps(dd, d2), _mm_store_ps(rr, c3);
-      for (int k = 0; k < 4; k++) {
-        float d = std::sqrt(dd[k]);
-        float cos_a = d > 0 ? -(sp.refl.x * ax[k] + sp.refl.y * ay[k] + sp.refl.z * az[k]) / d : 1.0f;
-        fac[k] = gloss_factor(sp, cos_min, cos_a, d > rr[k] ? rr[k] / d : 1.0f);
-      }
-      g = _mm_mul_ps(g, _mm_load_ps(fac));
+      // The lobe's factor toward the four spheres (centre at -(dx, dy, dz) from the point, radius c3); a point at a
+      // centre (d = 0) is inside its sphere.
+      __m128 d = _mm_max_ps(_mm_sqrt_ps(d2), tiny);
+      __m128 rd = _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, dx), _mm_mul_ps(ry, dy)), _mm_mul_ps(rz, dz));
+      __m128 cos_a = _mm_max_ps(_mm_set1_ps(-1.0f), _mm_min_ps(one, _mm_div_ps(_mm_sub_ps(zero, rd), d)));
+      g = _mm_mul_ps(g, gloss_factor4(sp, cos_a, _mm_div_ps(c3, d)));
     }
     g = _mm_and_ps(front, g);
     _mm_storeu_ps(gf + j0, g);
@@ -224,7 +226,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     float front = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
     float cos_bound = orientation ? receiver_cos_bound(sp.n, lights->sun_dir, sun_sin, sun_cos) : 1.0f;
     gf[tc] = front * std::min(1.0f, std::max(cos_bound, orientation_floor));
-    if (gloss) gf[tc] *= gloss_factor(sp, cos_min, dot(sp.refl, lights->sun_dir), sun_sin);
+    if (gloss) gf[tc] *= _mm_cvtss_f32(gloss_factor4(sp, _mm_set1_ps(dot(sp.refl, lights->sun_dir)), _mm_set1_ps(sun_sin)));
     wf[tc] = W[tc] * gf[tc];
     front_mask |= gf[tc] > 0;
     if (ctx.cv) {
