@@ -226,7 +226,8 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
     float front = dot(sp.n, lights->sun_dir) > -sun_sin - 1e-6f ? 1.0f : 0.0f;
     float cos_bound = orientation ? receiver_cos_bound(sp.n, lights->sun_dir, sun_sin, sun_cos) : 1.0f;
     gf[tc] = front * std::min(1.0f, std::max(cos_bound, orientation_floor));
-    if (gloss) gf[tc] *= _mm_cvtss_f32(gloss_factor4(sp, _mm_set1_ps(dot(sp.refl, lights->sun_dir)), _mm_set1_ps(sun_sin)));
+    if (gloss)
+      gf[tc] *= _mm_cvtss_f32(gloss_factor4(sp, _mm_set1_ps(dot(sp.refl, lights->sun_dir)), _mm_set1_ps(sun_sin)));
     wf[tc] = W[tc] * gf[tc];
     front_mask |= gf[tc] > 0;
     if (ctx.cv) {
