@@ -95,38 +95,6 @@ discrete_data make_discrete(const float* weights, int n) {
   return d;
 }
 
-alias_data make_alias(const discrete_data& d) {
-  alias_data a;
-  if (d.cdf.empty()) return a;
-  int n = int(d.cdf.size()) - 1;
-  std::vector<double> q(static_cast<size_t>(n));
-  std::vector<int> small, large;
-  int positive = -1;
-  for (int i = 0; i < n; i++) {
-    double p = discrete_pmf(d, i);
-    q[size_t(i)] = p * n;
-    if (p > 0 && (positive < 0 || p > discrete_pmf(d, positive))) positive = i;
-    (q[size_t(i)] < 1 ? small : large).push_back(i);
-  }
-  a.prob.assign(size_t(n), 1.0);
-  a.alias.resize(size_t(n));
-  for (int i = 0; i < n; i++) a.alias[size_t(i)] = i;
-  while (!small.empty() && !large.empty()) {
-    int l = small.back(), g = large.back();
-    small.pop_back();
-    large.pop_back();
-    a.prob[size_t(l)] = q[size_t(l)];
-    a.alias[size_t(l)] = g;
-    q[size_t(g)] = (q[size_t(g)] + q[size_t(l)]) - 1;
-    (q[size_t(g)] < 1 ? small : large).push_back(g);
-  }
-  // What rounding leaves over keeps its whole cell (prob 1), except an item of probability zero, which gives its
-  // cell to the most probable item (left over only if the shares fell short of 1 by more than 1/n: a defence).
-  for (int i : small)
-    if (!(discrete_pmf(d, i) > 0)) a.prob[size_t(i)] = 0, a.alias[size_t(i)] = positive;
-  return a;
-}
-
 int sample_cdf(const double* cdf, int n, double u) {
   // First cdf entry > u, minus one: the item whose half-open cell [cdf[i], cdf[i+1]) contains u. Short cdfs
   // (most cuts: a handful of clusters) count the entries <= u without branches, which is the same index for a

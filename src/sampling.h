@@ -5,7 +5,6 @@
 
 #include "math.h"
 
-#include <algorithm>
 #include <vector>
 
 namespace bl {
@@ -67,21 +66,6 @@ discrete_data make_discrete(const float* weights, int n);
 bool fill_cdf(const double* weights, int n, double* cdf);
 // Index i with cdf[i] <= u < cdf[i+1] in cdf[0..n]; never an item of probability zero.
 int sample_cdf(const double* cdf, int n, double u);
-// Walker's alias table of a discrete distribution: item i's cell [i/n, (i+1)/n) of u picks i below prob[i] of its
-// width, else alias[i]. O(1) per sample; items of probability zero are never picked (prob 0, alias positive).
-struct alias_data {
-  std::vector<double> prob;
-  std::vector<int> alias;
-};
-// The alias table of d (Vose's construction, items taken in index order: deterministic); empty when d is.
-alias_data make_alias(const discrete_data& d);
-inline int sample_alias(const alias_data& a, double u) {
-  if (a.prob.empty()) return -1;
-  int n = int(a.prob.size());
-  double x = u * n;
-  int i = std::min(int(x), n - 1);
-  return x - i < a.prob[size_t(i)] ? i : a.alias[size_t(i)];
-}
 // Index sampled from d with u; -1 when the distribution is empty.
 inline int sample_discrete(const discrete_data& d, double u) {
   return d.cdf.empty() ? -1 : sample_cdf(d.cdf.data(), int(d.cdf.size()) - 1, u);

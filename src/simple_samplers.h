@@ -4,8 +4,6 @@
 #include "light_sampler_types.h"
 #include "sampling.h"
 
-#include <utility>
-
 namespace bl {
 
 // Every light equally likely.
@@ -29,14 +27,11 @@ struct uniform_sampler {
 struct power_sampler {
   static constexpr bool learns = false;
   struct context {};
-  discrete_data dist;  // the pmf
-  alias_data table;    // sampling in O(1): with hundreds of lights a binary search cost 13 % of a direct render
-  power_sampler() = default;
-  explicit power_sampler(discrete_data d) : dist(std::move(d)), table(make_alias(dist)) {}
+  discrete_data dist;
   void locate(context&, const shade_point&) const {}
   void prepare(context&, const shade_point&) const {}
   light_choice sample(const context&, double u, double) const {
-    int i = sample_alias(table, u);
+    int i = sample_discrete(dist, u);
     if (i < 0) return {};
     return {i, float(discrete_pmf(dist, i))};
   }
