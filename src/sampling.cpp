@@ -91,8 +91,27 @@ discrete_data make_discrete(const float* weights, int n) {
   std::vector<double> w(static_cast<size_t>(n));
   for (int i = 0; i < n; i++) w[size_t(i)] = weights[i];
   d.cdf.resize(size_t(n) + 1);
-  if (!fill_cdf(w.data(), n, d.cdf.data())) d.cdf.clear();
+  if (!fill_cdf(w.data(), n, d.cdf.data())) {
+    d.cdf.clear();
+    return d;
+  }
+  if (n > 16) {
+    d.guide.resize(size_t(n));
+    for (int k = 0; k < n; k++) d.guide[size_t(k)] = sample_cdf(d.cdf.data(), n, double(k) / n);
+  }
   return d;
+}
+
+int sample_discrete(const discrete_data& d, double u) {
+  if (d.cdf.empty()) return -1;
+  int n = int(d.cdf.size()) - 1;
+  if (d.guide.empty()) return sample_cdf(d.cdf.data(), n, u);
+  // From the item at the start of u's guide cell, walk to the one whose [cdf[i], cdf[i+1]) holds u (back as well,
+  // should rounding put u below the cell's start): the item sample_cdf finds.
+  int i = d.guide[size_t(std::min(std::max(int(u * n), 0), n - 1))];
+  while (i > 0 && d.cdf[size_t(i)] > u) i--;
+  while (i < n - 1 && d.cdf[size_t(i) + 1] <= u) i++;
+  return i;
 }
 
 int sample_cdf(const double* cdf, int n, double u) {

@@ -58,6 +58,7 @@ constexpr double min_positive_share = 0x1p-40;
 // A discrete distribution over n items built from non-negative weights.
 struct discrete_data {
   std::vector<double> cdf;  // n + 1 entries, cdf[0] = 0, cdf[n] = 1 (empty when all weights are zero)
+  std::vector<int> guide;   // n > 16: guide[k] is the item at u = k / n, where sample_discrete starts its walk
 };
 
 // Builds the cdf (accumulated in double, in index order; positive weights floored at min_positive_share).
@@ -66,10 +67,9 @@ discrete_data make_discrete(const float* weights, int n);
 bool fill_cdf(const double* weights, int n, double* cdf);
 // Index i with cdf[i] <= u < cdf[i+1] in cdf[0..n]; never an item of probability zero.
 int sample_cdf(const double* cdf, int n, double u);
-// Index sampled from d with u; -1 when the distribution is empty.
-inline int sample_discrete(const discrete_data& d, double u) {
-  return d.cdf.empty() ? -1 : sample_cdf(d.cdf.data(), int(d.cdf.size()) - 1, u);
-}
+// Index sampled from d with u; -1 when the distribution is empty. The same item as sample_cdf (the cdf is inverted,
+// so stratified u stay stratified over the items), found from the guide table in O(1) expected steps.
+int sample_discrete(const discrete_data& d, double u);
 // Probability of item i (exactly what sample_discrete realises).
 inline double discrete_pmf(const discrete_data& d, int i) {
   return d.cdf.empty() ? 0.0 : d.cdf[size_t(i) + 1] - d.cdf[size_t(i)];

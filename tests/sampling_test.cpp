@@ -143,6 +143,45 @@ TEST_CASE("discrete distributions sample their pmf and never pick zero weights",
   CHECK(w[size_t(sample_discrete(d, 0x1.fffffep-1f))] > 0);
 }
 
+TEST_CASE("the guide table finds the item the cdf search finds", "[sampling]") {
+  // Distributions of 17 to 2000 items (zeros in runs, tiny and huge weights, equal weights): for u at every guide
+  // cell's start, just below and above it, at the cdf's own steps and at random, sample_discrete picks the item
+  // sample_cdf picks (the inversion, which keeps stratified u stratified), never one of weight zero.
+  pcg32 rng(91, 4);
+  int mismatches = 0, zero_picks = 0, checked = 0;
+  for (int c = 0; c < 60; c++) {
+    int n = 17 + int(rng() % (c < 50 ? 200 : 2000));
+    std::vector<float> w(static_cast<size_t>(n));
+    for (int i = 0; i < n; i++) {
+      float r = uint_to_unit(rng());
+      w[size_t(i)] = c % 5 == 0 ? 1.0f : (r < 0.3f ? 0.0f : std::exp(30 * uint_to_unit(rng()) - 15));
+    }
+    if (c % 3 == 0)
+      for (int i = 0; i < n / 3; i++) w[size_t(i)] = 0;  // a run of zeros
+    discrete_data d = make_discrete(w.data(), n);
+    if (d.cdf.empty()) continue;
+    REQUIRE(d.guide.size() == size_t(n));
+    std::vector<double> us = {0.0, 0x1.fffffffffffffp-1};
+    for (int k = 0; k <= n; k++) {
+      double x = double(k) / n;
+      us.insert(us.end(), {x, std::nextafter(x, 0.0), std::nextafter(x, 1.0), d.cdf[size_t(k)],
+                           std::nextafter(d.cdf[size_t(k)], 0.0)});
+    }
+    for (int k = 0; k < 2000; k++) us.push_back(double(uniform_pair(13, uint64_t(k)).x));
+    for (double u : us) {
+      if (!(u >= 0 && u < 1)) continue;
+      int a = sample_discrete(d, u), b = sample_cdf(d.cdf.data(), n, u);
+      checked++;
+      mismatches += a != b;
+      zero_picks += w[size_t(a)] == 0;
+    }
+  }
+  INFO(checked << " samples checked");
+  CHECK(checked > 100000);
+  CHECK(mismatches == 0);
+  CHECK(zero_picks == 0);
+}
+
 TEST_CASE("an all zero distribution is empty", "[sampling]") {
   std::vector<float> w = {0, 0, 0};
   discrete_data d = make_discrete(w.data(), 3);
