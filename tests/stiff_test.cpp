@@ -307,6 +307,20 @@ TEST_CASE("a grazing continuation ray hits neither the triangle it leaves nor a 
   }
 }
 
+namespace {
+
+// A horizontal disk lamp of 16 fan triangles centred at c, facing down (-y); increasing angle about +y gives that
+// normal.
+void add_down_disk(mesh_builder& m, vec3f c, float radius, int material) {
+  for (int i = 0; i < 16; i++) {
+    float a0 = 2 * pi_f * float(i) / 16, a1 = 2 * pi_f * float(i + 1) / 16;
+    m.add_triangle(c, c + vec3f{radius * std::cos(a0), 0, radius * std::sin(a0)},
+                   c + vec3f{radius * std::cos(a1), 0, radius * std::sin(a1)}, material);
+  }
+}
+
+}  // namespace
+
 TEST_CASE("disk lamps seen partly past blockers render consistently with every sampler, members included", "[stiff]") {
   // Two disk lamps of 16 fan triangles each (32 lights: cuts are clustered, so bayes refines each disk into members,
   // learned apart), each half hidden by a black blocker just below it: the floor sees some triangles of a disk and not
@@ -317,14 +331,7 @@ TEST_CASE("disk lamps seen partly past blockers render consistently with every s
   int lamps[2] = {m.add_material({0, 0, 0}, {40, 36, 30}), m.add_material({0, 0, 0}, {15, 15, 20})};
   m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
   for (float x : {-0.8f, 0.8f}) {
-    int lamp = lamps[x > 0];
-    vec3f c = {x, 1.5f, 0};
-    for (int i = 0; i < 16; i++) {
-      float a0 = 2 * pi_f * float(i) / 16, a1 = 2 * pi_f * float(i + 1) / 16;
-      // Increasing angle about +y: the triangle's normal points down (-y), toward the floor.
-      m.add_triangle(c, c + vec3f{0.15f * std::cos(a0), 0, 0.15f * std::sin(a0)},
-                     c + vec3f{0.15f * std::cos(a1), 0, 0.15f * std::sin(a1)}, lamp);
-    }
+    add_down_disk(m, {x, 1.5f, 0}, 0.15f, lamps[x > 0]);
     m.add_box({x - 0.3f, 1.38f, -0.3f}, {x, 1.4f, 0.3f}, black);
   }
   auto b = build(std::move(m.mesh), looking_down({0, 4, 0.01f}, {0, 0, 0}, 70));
@@ -343,15 +350,7 @@ TEST_CASE("a glossy floor mirroring disk lamps renders consistently with every s
   int floor = m.add_material({0.05f, 0.05f, 0.05f}, {0, 0, 0}, {0.6f, 0.6f, 0.6f}, 200);
   int lamps[2] = {m.add_material({0, 0, 0}, {40, 36, 30}), m.add_material({0, 0, 0}, {15, 15, 20})};
   m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
-  for (float x : {-0.8f, 0.8f}) {
-    int lamp = lamps[x > 0];
-    vec3f c = {x, 1.0f, 0};
-    for (int i = 0; i < 16; i++) {
-      float a0 = 2 * pi_f * float(i) / 16, a1 = 2 * pi_f * float(i + 1) / 16;
-      m.add_triangle(c, c + vec3f{0.3f * std::cos(a0), 0, 0.3f * std::sin(a0)},
-                     c + vec3f{0.3f * std::cos(a1), 0, 0.3f * std::sin(a1)}, lamp);
-    }
-  }
+  for (float x : {-0.8f, 0.8f}) add_down_disk(m, {x, 1.0f, 0}, 0.3f, lamps[x > 0]);
   camera_params cam = looking_down({0, 0.6f, 2.5f}, {0, 0, -1.2f}, 60);
   cam.up = {0, 1, 0};
   auto b = build(std::move(m.mesh), cam);
