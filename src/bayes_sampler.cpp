@@ -29,7 +29,8 @@ constexpr float orientation_floor = 1e-3f;
 // of the lobe's largest value over the sphere's directions, at least orientation_floor (a cluster the front test keeps
 // stays possible, and z = Y / factor bounded). With c the largest cosine to the mirror direction over the sphere,
 // c^n <= exp(-n (1 - c)) <= (1 + n (1 - c) / 256)^-256: eight squarings and a division, no pow (a few per cent looser
-// than c^n where the lobe matters, 1.6x at 0.1 below its peak when n = 100).
+// than c^n where the lobe matters, 1.6x at 0.1 below its peak when n = 100); and the lobe's term is at most its
+// average over the sphere's solid angle (below).
 __m128 gloss_factor4(const shade_point& sp, __m128 cos_a, __m128 sin_t) {
   const __m128 one = _mm_set1_ps(1.0f), zero = _mm_setzero_ps();
   __m128 inside = _mm_cmpge_ps(sin_t, one);
@@ -41,8 +42,14 @@ __m128 gloss_factor4(const shade_point& sp, __m128 cos_a, __m128 sin_t) {
   c = _mm_or_ps(_mm_and_ps(full, one), _mm_andnot_ps(full, _mm_min_ps(c, one)));
   __m128 t = _mm_add_ps(one, _mm_mul_ps(_mm_set1_ps(sp.ns * (1.0f / 256)), _mm_sub_ps(one, c)));
   for (int k = 0; k < 8; k++) t = _mm_mul_ps(t, t);  // t^256 (inf far off the lobe: the bound is then 0)
-  __m128 lobe = _mm_div_ps(one, t);
-  __m128 f = _mm_add_ps(_mm_set1_ps(sp.gloss_base), _mm_mul_ps(_mm_set1_ps(sp.gloss_peak), lobe));
+  __m128 lobe = _mm_mul_ps(_mm_set1_ps(sp.gloss_peak), _mm_div_ps(one, t));
+  // A lobe narrower than the sphere's solid angle W = 2 pi (1 - cos_t) gives at most its integral (ks's share times
+  // pi) spread over W on average: a sharp lobe's peak is no model of a cluster's mean (a mirror would weigh a lamp
+  // it meets 1e29 times its diffuse light, and starve the rest).
+  __m128 one_minus_cos_t = _mm_or_ps(_mm_and_ps(inside, one),
+                                     _mm_andnot_ps(inside, _mm_div_ps(_mm_mul_ps(sin_t, sin_t), _mm_add_ps(one, cos_t))));
+  __m128 spread = _mm_div_ps(_mm_set1_ps(0.5f * (1 - sp.gloss_base)), _mm_max_ps(one_minus_cos_t, _mm_set1_ps(1e-30f)));
+  __m128 f = _mm_add_ps(_mm_set1_ps(sp.gloss_base), _mm_min_ps(lobe, spread));
   return _mm_max_ps(f, _mm_set1_ps(orientation_floor));
 }
 
@@ -137,8 +144,8 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   // point multiplies g by the lobe's factor (gloss_factor4), and where the region has members weighs them instead of
   // its clusters, each as a cluster of its own.
   size_t base = size_t(ctx.pair_base);
-  ctx.cv = params.control_variate && sp.last;
   const bool gloss = params.bsdf_factor && sp.gloss_peak > 0;
+  ctx.cv = params.control_variate && sp.last && !gloss;
   if (gloss && ctx.pair_count != ctx.count && ctx.pair_count <= max_cut_entries) {
     // A glossy point weighs every member as its own cluster (with its own lobe factor): which lights a highlight
     // mirrors changes faster across a region than the members' region-wide weights can follow.
