@@ -46,8 +46,8 @@ __m128 gloss_factor4(const shade_point& sp, __m128 cos_a, __m128 sin_t) {
   // A lobe narrower than the sphere's solid angle W = 2 pi (1 - cos_t) gives at most its integral (ks's share times
   // pi) spread over W on average: a sharp lobe's peak is no model of a cluster's mean (a mirror would weigh a lamp
   // it meets 1e29 times its diffuse light, and starve the rest).
-  __m128 one_minus_cos_t = _mm_or_ps(_mm_and_ps(inside, one),
-                                     _mm_andnot_ps(inside, _mm_div_ps(_mm_mul_ps(sin_t, sin_t), _mm_add_ps(one, cos_t))));
+  __m128 cap = _mm_div_ps(_mm_mul_ps(sin_t, sin_t), _mm_add_ps(one, cos_t));  // 1 - cos_t without cancellation
+  __m128 one_minus_cos_t = _mm_or_ps(_mm_and_ps(inside, one), _mm_andnot_ps(inside, cap));
   __m128 spread = _mm_div_ps(_mm_set1_ps(0.5f * (1 - sp.gloss_base)), _mm_max_ps(one_minus_cos_t, _mm_set1_ps(1e-30f)));
   __m128 f = _mm_add_ps(_mm_set1_ps(sp.gloss_base), _mm_min_ps(lobe, spread));
   return _mm_max_ps(f, _mm_set1_ps(orientation_floor));
