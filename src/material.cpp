@@ -13,7 +13,7 @@ bsdf_data make_bsdf(const scene_data& scene, const surface_point& sp) {
   b.kd = m.kd;
   if (m.kd_texture != invalid_id) b.kd = b.kd * eval_texture_rgb(scene.mesh.textures[m.kd_texture], sp.uv);
   b.ks = m.ks;
-  b.ns = std::max(m.ns, 0.0f);
+  b.ns = std::min(std::max(m.ns, 0.0f), max_phong_exponent);
   float total = max_component(b.kd + b.ks);
   if (total > 1) {
     b.kd = b.kd / total;

@@ -11,6 +11,11 @@
 
 namespace bl {
 
+// Largest Phong exponent a BSDF uses (a lobe about 1 mrad wide): sharper ones are clamped to it, since in float the
+// lobe cos^n of a larger exponent is exactly 1 over a cone of ~3e-4 rad and its normalisation (n + 2) / 2 pi
+// overflows the pdfs (non-finite samples) long before it reaches a mirror.
+constexpr float max_phong_exponent = 1e6f;
+
 // The BSDF at one surface point, resolved from material and textures.
 struct bsdf_data {
   vec3f kd, ks;       // albedos after energy scaling

@@ -348,8 +348,9 @@ TEST_CASE("a glossy floor mirroring disk lamps renders consistently with every s
   // a factor between 1e-3 and about 80 times the diffuse one with a Phong exponent of 200. With an exponent of 1e30
   // (a mirror: the factor reaches 1e29 where the mirror direction meets a cluster) the weights and learned means
   // span 30 decades; a control variate c_j scaled by such a factor once turned pixels into +-1e26 rounding noise.
-  for (float ns : {200.0f, 1000.0f}) {
+  for (float ns : {200.0f, 1000.0f, 1e30f}) {
     INFO("Phong exponent " << ns);
+    const bool mirror = ns > max_phong_exponent;  // clamped to max_phong_exponent by make_bsdf
     mesh_builder m;
     int floor = m.add_material({0.05f, 0.05f, 0.05f}, {0, 0, 0}, {0.6f, 0.6f, 0.6f}, ns);
     int lamps[2] = {m.add_material({0, 0, 0}, {40, 36, 30}), m.add_material({0, 0, 0}, {15, 15, 20})};
@@ -359,6 +360,25 @@ TEST_CASE("a glossy floor mirroring disk lamps renders consistently with every s
     cam.up = {0, 1, 0};
     auto b = build(std::move(m.mesh), cam);
     REQUIRE(b->lights.tri_count == 32);
+    if (mirror) {
+      // A mirror's highlights are too noisy for the agreement test at this size; every sample must stay finite
+      // (unclamped, the lobe's pdf overflowed in path tracing, and bayes's factor and control variates blew up).
+      for (sampler_kind kind : {sampler_kind::uniform, sampler_kind::bayes})
+        for (int depth : {1, 3}) {
+          render_params p;
+          p.width = p.height = image_size;
+          p.spp = 64;
+          p.max_depth = depth;
+          p.sampler.kind = kind;
+          render_result r = render(b->scene, b->bvh, b->lights, p);
+          INFO(sampler_name(kind) << " depth " << depth);
+          CHECK(r.stats.bad_samples == 0);
+          double most = 0;
+          for (double v : r.film) most = std::max(most, std::fabs(v / r.film_weight));
+          CHECK(most < 1e4);
+        }
+      continue;
+    }
     check_scene(*b, 1, 4096);  // highlights are noisy for the samplers that ignore the lobe
     check_scene(*b, 3, 4096);
     check_bayes_state(*b, 1);
