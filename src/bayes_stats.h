@@ -42,7 +42,8 @@ struct bayes_params {
   bool bsdf_factor = true;       // region prior: at a glossy point the factor also holds the Phong lobe's largest
                                  // value toward the cluster's bounding sphere (over the albedo scale), and a region
                                  // with members is weighed member by member there (a highlight is sharper than a
-                                 // region: which lights it mirrors changes across the region)
+                                 // region: which lights it mirrors changes across the region); no control variates
+                                 // at such points (a learned mean times a factor far above the diffuse one)
   bool orientation = true;       // region prior: the point factor of a cluster is its receiver cosine bound / d^2
                                  // (z = Y d^2 / cos), not 1 / d^2 alone: the regression also learns what the
                                  // orientation of the point explains

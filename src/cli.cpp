@@ -358,7 +358,7 @@ void add_render_options(CLI::App* r, render_options& o) {
                        "Ablation: a point scales a cluster's weight by 1/d^2 only, not also by the receiver cosine bound")
       ->group(bg);
   r->add_flag_callback("--bayes-no-bsdf-factor", [&o] { o.bayes.bsdf_factor = false; },
-                       "Ablation: a glossy point weighs clusters as a diffuse one would (no Phong lobe in the point factor)")
+                       "Ablation: a glossy point weighs clusters as a diffuse one would (no Phong lobe in its factor)")
       ->group(bg);
   r->add_flag_callback("--bayes-no-regression", [&o] { o.bayes.distance_regression = false; },
                        "Ablation: no 1/d^2 distance regression (z = Y)")->group(bg);
