@@ -132,9 +132,10 @@ bool is_frame_pattern(const std::string& p) {
   // A field width of at most two digits (%04d): a wider one would make names longer than a path may be.
   return k < p.size() && k - at - 1 <= 2 && p[k] == 'd' && p.find('%', k) == std::string::npos;
 }
-// The path of frame `frame` of a frame pattern (the path itself when it is not a pattern).
-std::string frame_path(const std::string& pattern, int frame) {
-  if (!is_frame_pattern(pattern)) return pattern;
+// The path of frame `frame` of a frame pattern in an animation of `frames` frames. A single-frame render takes
+// the path as written, '%' and all: only --frames makes a name a pattern.
+std::string frame_path(const std::string& pattern, int frame, int frames) {
+  if (frames <= 1 || !is_frame_pattern(pattern)) return pattern;
   char buf[4096];
   std::snprintf(buf, sizeof buf, pattern.c_str(), frame);
   return buf;
@@ -165,8 +166,8 @@ int run_render(const render_options& o) {
   }
   if (o.frames > 1 && (!o.checkpoint.empty() || !o.resume.empty()))
     throw usage_error("--checkpoint and --resume are not supported with --frames");
-  for (const std::string& out : outputs) check_output_path(frame_path(out, 0));
-  if (!o.log.empty()) check_output_path(frame_path(o.log, 0));
+  for (const std::string& out : outputs) check_output_path(frame_path(out, 0, o.frames));
+  if (!o.log.empty()) check_output_path(frame_path(o.log, 0, o.frames));
   if (!o.checkpoint.empty()) check_output_path(o.checkpoint);
   std::string resume_bytes;
   if (!o.resume.empty()) resume_bytes = read_file(o.resume);
@@ -175,7 +176,8 @@ int run_render(const render_options& o) {
   render_params params = resolve_params(o, desc, kind);
   std::vector<image_data> references;
   if (!o.reference.empty())
-    for (int f = 0; f < params.frames; f++) references.push_back(load_reference(frame_path(o.reference, f), params));
+    for (int f = 0; f < params.frames; f++)
+      references.push_back(load_reference(frame_path(o.reference, f, o.frames), params));
   for (const image_data& r : references) params.frame_references.push_back(&r);
   auto t_load = std::chrono::steady_clock::now();
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
@@ -183,9 +185,9 @@ int run_render(const render_options& o) {
   {
     std::vector<std::pair<std::string, std::string>> outs, ins = {{o.scene, "scene file"}};
     for (int f = 0; f < params.frames; f++) {
-      for (const std::string& out : outputs) outs.push_back({frame_path(out, f), "output"});
-      if (!o.log.empty()) outs.push_back({frame_path(o.log, f), "log"});
-      if (!o.reference.empty()) ins.push_back({frame_path(o.reference, f), "reference"});
+      for (const std::string& out : outputs) outs.push_back({frame_path(out, f, o.frames), "output"});
+      if (!o.log.empty()) outs.push_back({frame_path(o.log, f, o.frames), "log"});
+      if (!o.reference.empty()) ins.push_back({frame_path(o.reference, f, o.frames), "reference"});
     }
     if (!o.checkpoint.empty()) outs.push_back({o.checkpoint, "checkpoint"});
     for (const std::string& src : scene.mesh.source_files) ins.push_back({src, "scene input"});
@@ -230,12 +232,12 @@ int run_render(const render_options& o) {
   bool interrupted = false;
   render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
     std::vector<std::string> files;
-    for (const std::string& out : outputs) files.push_back(frame_path(out, frame));
+    for (const std::string& out : outputs) files.push_back(frame_path(out, frame, o.frames));
     if (result.spp > 0) {
       image_data img = film_image(result);
       for (const std::string& f : files) write_image(f, img);
     }
-    if (!o.log.empty()) write_file_atomic(frame_path(o.log, frame), pass_log_csv(o.sampler, result.log));
+    if (!o.log.empty()) write_file_atomic(frame_path(o.log, frame, o.frames), pass_log_csv(o.sampler, result.log));
     if (!o.quiet || result.interrupted) {
       std::string prefix = params.frames > 1 ? "frame " + std::to_string(frame) + ": " : "";
       std::fprintf(stderr, "%s%s\n", prefix.c_str(), render_summary(result, files).c_str());

@@ -11,6 +11,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstdio>
+#include <filesystem>
 
 using namespace bl;
 using namespace bl::test;
@@ -115,4 +116,16 @@ TEST_CASE("frame patterns are required for animated outputs", "[animation]") {
   auto r = run_bayeslight("render " + anim + " --frames 3 --quiet -o " + (a.dir / "plain.pfm"));
   CHECK(r.status == 2);
   CHECK(r.output.find("frame pattern") != std::string::npos);
+}
+
+TEST_CASE("without --frames an output name is taken literally, % and all", "[animation]") {
+  anim_scene a;
+  std::string scene = a.scene("still.json", sun_start, nullptr);
+  std::string pattern = a.dir / "still_%d.pfm", log = a.dir / "still_%02d.csv";
+  auto r = run_bayeslight("render " + scene + " --spp 2 --quiet -o " + pattern + " --log " + log);
+  REQUIRE(r.status == 0);
+  CHECK(std::filesystem::exists(pattern));
+  CHECK(std::filesystem::exists(log));
+  CHECK_FALSE(std::filesystem::exists(a.dir / "still_0.pfm"));
+  CHECK_FALSE(std::filesystem::exists(a.dir / "still_00.csv"));
 }
