@@ -140,8 +140,8 @@ void read_regions(reader& r, region_state& s) {
 }
 
 // Field f of a pair's statistics: n0, n1, mean, m2.
-double& moment_field(pair_moments& m, int f) { return f == 0 ? m.n0 : f == 1 ? m.n1 : f == 2 ? m.mean : m.m2; }
-double moment_field(const pair_moments& m, int f) { return f == 0 ? m.n0 : f == 1 ? m.n1 : f == 2 ? m.mean : m.m2; }
+template <class M>  // pair_moments, or const pair_moments to read
+auto& moment_field(M& m, int f) { return f == 0 ? m.n0 : f == 1 ? m.n1 : f == 2 ? m.mean : m.m2; }
 
 void write_sampler(writer& w, const light_sampler& ls) {
   if (auto* b = std::get_if<bound_sampler>(&ls)) write_regions(w, b->regions);
