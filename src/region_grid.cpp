@@ -185,7 +185,14 @@ bbox3f region_box(const region_grid_data& g, uint64_t key) {
   return {lo, lo + vec3f{c, c, c}};
 }
 
-bool add_pending(region_state& s, uint64_t key, uint32_t count) {
+namespace {
+
+// The pending count that marks a fine key over the pair budget: its region can never fit (the pair count only grows,
+// and a key's pairs are a function of the key), so the key is neither requested nor its cut computed again.
+constexpr int over_budget = -1;
+
+// The pending slot of a key, inserted with count 0 if new.
+region_slot& pending_slot(region_state& s, uint64_t key) {
   if (2 * (s.pending_count + 1) > s.pending.size()) {
     std::vector<region_slot> old = std::move(s.pending);
     s.pending.assign(std::max<size_t>(64, 2 * old.size()), region_slot{empty_region_key, 0});
@@ -204,8 +211,16 @@ bool add_pending(region_state& s, uint64_t key, uint32_t count) {
     s.pending[h] = {key, 0};
     s.pending_count++;
   }
-  s.pending[h].id = int(std::min<int64_t>(int64_t(s.pending[h].id) + count, 1 << 30));
-  return s.pending[h].id >= s.params.min_samples;
+  return s.pending[h];
+}
+
+}  // namespace
+
+bool add_pending(region_state& s, uint64_t key, uint32_t count) {
+  region_slot& slot = pending_slot(s, key);
+  if (slot.id == over_budget) return false;
+  slot.id = int(std::min<int64_t>(int64_t(slot.id) + count, 1 << 30));
+  return slot.id >= s.params.min_samples;
 }
 
 void remove_pending(region_state& s, uint64_t key) {
@@ -289,8 +304,12 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
   for (size_t i = 0; i < todo.size(); i++) {
     bool coarse = todo[i].parent_key == empty_region_key;
     int64_t n = s.shared_cut ? s.cut_size[0] : s.members ? int64_t(members[i].size()) : int64_t(cuts[i].size());
-    // Coarse regions are at most 1/512 of the fine ones; they ignore the budget. Over budget, the coarse region serves.
-    if (!coarse && s.pairs + n > s.params.max_pairs) continue;
+    // Coarse regions are at most 1/512 of the fine ones; they ignore the budget. Over budget, the coarse region serves
+    // for good (the key is marked in the pending table and not tried again).
+    if (!coarse && s.pairs + n > s.params.max_pairs) {
+      pending_slot(s, todo[i].key).id = over_budget;
+      continue;
+    }
     int parent = coarse ? invalid_id : find_region_key(s, todo[i].parent_key);
     append_region(s, todo[i].key, s.shared_cut ? nullptr : &cuts[i], s.members ? &members[i] : nullptr,
                   s.members ? &group[i] : nullptr, parent, &tree);

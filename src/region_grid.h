@@ -82,7 +82,8 @@ struct region_state {
   std::vector<int> pair_parent;        // per pair: the parent region's pair of the same member node, or invalid_id
   int64_t pairs = 0;                   // total (region, member) pairs
   std::vector<region_entry> table;     // open addressing; empty slots hold empty_region_key
-  std::vector<region_slot> pending;    // fine keys not yet created -> NEE samples requested so far (same scheme)
+  std::vector<region_slot> pending;    // fine keys not yet created -> NEE samples requested so far (same scheme;
+                                       // -1: over the pair budget, never created)
   size_t pending_count = 0;
   int root = 0;
 };
@@ -113,7 +114,8 @@ void rebuild_region_table(region_state& s);
 // The finest existing region containing the fine cell `fine_key` (the root at worst).
 int find_region(const region_state& s, uint64_t fine_key);
 
-// Adds `count` requests for the fine key; true when its total reached params.min_samples.
+// Adds `count` requests for the fine key; true when its total reached params.min_samples (never for a key that
+// add_regions found over the pair budget).
 bool add_pending(region_state& s, uint64_t key, uint32_t count);
 // Forgets the pending count of a key (its region is being created).
 void remove_pending(region_state& s, uint64_t key);

@@ -18,6 +18,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <sstream>
@@ -496,6 +497,53 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
     }
   }
   CHECK(checked > 1000);
+}
+
+TEST_CASE("fine regions over the pair budget are not created, and their keys are not tried again", "[samplers][regions]") {
+  // The fine cells that shading points reach, requested at once under a pair budget that holds about half of what
+  // they ask for: the regions that fit are created (coarse ones regardless of the budget), the others are not, and
+  // their keys stay out for good: their pairs are a function of the key and the pair count only grows, so a key
+  // once over the budget would only have its cut computed again at every pass, to be turned down again.
+  auto t = make_test_scene(false);
+  region_params rp;
+  rp.grid = 16;
+  rp.max_members = 8;
+  std::vector<uint64_t> keys;
+  region_state probe = make_region_state(t->scene.bounds, t->tree, false, rp);
+  for (const shade_point& sp : shading_points(*t, 400, 21)) keys.push_back(fine_region_key(probe.grid, sp.p));
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  REQUIRE(keys.size() > 20);
+  const int64_t base = probe.pairs;  // the root's
+  add_regions(probe, t->tree, keys);
+  int64_t wanted = probe.pairs - base;
+  REQUIRE(probe.members);
+  rp.max_pairs = base + wanted / 2;
+  region_state s = make_region_state(t->scene.bounds, t->tree, false, rp);
+  for (uint64_t key : keys) {
+    REQUIRE(add_pending(s, key, uint32_t(rp.min_samples)));
+    remove_pending(s, key);
+  }
+  int added = add_regions(s, t->tree, keys);
+  int64_t fine_pairs = 0;
+  for (size_t r = 0; r < s.key.size(); r++)
+    if (r != size_t(s.root) && !is_coarse_key(s.key[r])) fine_pairs += s.pair_count[r];
+  CHECK(fine_pairs <= rp.max_pairs);
+  std::vector<uint64_t> refused;
+  for (uint64_t key : keys)
+    if (find_region_key(s, key) == invalid_id) refused.push_back(key);
+  INFO(keys.size() << " fine keys, " << added << " regions added, " << refused.size() << " refused");
+  REQUIRE(!refused.empty());
+  REQUIRE(refused.size() < keys.size());
+  for (uint64_t key : refused) {
+    int r = find_region(s, key);
+    CHECK(is_coarse_key(s.key[size_t(r)]));           // its coarse region serves it
+    CHECK_FALSE(add_pending(s, key, 1u << 20));       // however many samples ask for it again
+  }
+  // Asked for anyway, they still create nothing; a key never refused is still counted as before.
+  CHECK(add_regions(s, t->tree, refused) == 0);
+  CHECK_FALSE(add_pending(s, ~uint64_t(0) >> 3, uint32_t(rp.min_samples - 1)));
+  CHECK(add_pending(s, ~uint64_t(0) >> 3, 1));
 }
 
 TEST_CASE("a scene without any light gives empty light selections", "[samplers]") {
