@@ -344,8 +344,14 @@ image_data film_image(const render_result& r) {
   img.width = r.width;
   img.height = r.height;
   img.pixels.assign(r.film.size(), 0.0f);
+  // Values below zero (bayes's control variates make a pixel's unbiased mean noisy around a true zero) are written
+  // as zero: radiance is never negative, and against any reference (which is not) this only lowers the error. The
+  // film keeps the unclamped sums (checkpoints, the fallback check, and averages over renders stay unbiased).
   if (r.spp > 0 && r.film_weight > 0)
-    for (size_t i = 0; i < r.film.size(); i++) img.pixels[i] = float(r.film[i] / r.film_weight);
+    for (size_t i = 0; i < r.film.size(); i++) {
+      float v = float(r.film[i] / r.film_weight);
+      img.pixels[i] = v <= 0 ? 0.0f : v;  // (-0 too; NaN stays NaN: the film never holds one, tests check it does not)
+    }
   return img;
 }
 

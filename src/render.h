@@ -94,7 +94,7 @@ render_result render(const scene_data& scene, const bvh_data& bvh, const light_d
 // on_frame(k, result) after each frame; stops after an interrupted frame (its result says so).
 void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lights, const render_params& params,
                    const std::function<void(int, const render_result&)>& on_frame);
-// The film's weighted mean image (zero when no sample completed).
+// The film's weighted mean image, negative values written as zero (zero when no sample completed).
 image_data film_image(const render_result& r);
 
 // Installs SIGINT/SIGTERM handlers that request the render to stop; returns the signal seen (0: none).
