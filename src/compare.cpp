@@ -267,12 +267,12 @@ void write_comparison(const compare_data& data, const compare_params& p, const i
   write_file_atomic(out_path(p, summary_file), comparison_summary(data, p));
 }
 
-// Creates the output directory when missing (its parent must exist); throws output_error when it cannot be
-// used.
+// Creates the output directory when missing, with any missing parents (as mkdir -p); throws output_error when it
+// cannot be used.
 static void make_output_dir(const std::string& dir) {
   std::error_code ec;
   if (!fs::exists(dir, ec)) {
-    if (!fs::create_directory(dir, ec) && !fs::is_directory(dir))
+    if (!fs::create_directories(dir, ec) && !fs::is_directory(dir))
       throw output_error("cannot create directory " + dir + ": " + ec.message());
   }
   if (!fs::is_directory(dir, ec)) throw output_error("cannot write into " + dir + ": not a directory");

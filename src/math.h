@@ -45,10 +45,16 @@ inline vec3f cross(vec3f a, vec3f b) {
 }
 inline float length_sq(vec3f a) { return dot(a, a); }
 inline float length(vec3f a) { return std::sqrt(dot(a, a)); }
-// Unit vector along a; a zero vector stays zero (never NaN).
+// Unit vector along a; a zero (or NaN) vector gives zero, never NaN. A vector so long or so short that its squared
+// length leaves float's normal range is first scaled by its largest component (the common case is a / |a|).
 inline vec3f normalize(vec3f a) {
   float l = length(a);
-  return l > 0 ? a / l : vec3f{0, 0, 0};
+  if (l > 1e-18f && l < 1e18f) return a / l;
+  float m = std::max(std::fabs(a.x), std::max(std::fabs(a.y), std::fabs(a.z)));
+  if (!(m > 0)) return {0, 0, 0};
+  if (!(m < std::numeric_limits<float>::infinity())) return {0, 0, 0};  // an infinite component has no direction
+  a = a / m;
+  return a / length(a);
 }
 inline vec3f vmin(vec3f a, vec3f b) { return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)}; }
 inline vec3f vmax(vec3f a, vec3f b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }

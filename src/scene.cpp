@@ -53,7 +53,7 @@ scene_data build_scene(const scene_desc& desc, float aspect) {
   scene_data s = build_scene(load_obj(desc.mesh_path), desc.camera, desc.sun, desc.two_sided_emitters, aspect);
   // A camera completed from the mesh bounds (scene_desc.h) can only be checked now.
   vec3f dir = s.camera.target - s.camera.eye;
-  if (!(length(dir) > 0))
+  if (!(length(normalize(dir)) > 0))
     throw input_error(desc.path, "the camera's \"eye\" is the mesh's centre, its default \"target\": give a target");
   if (!(length(cross(normalize(dir), normalize(s.camera.up))) > 1e-6f))
     throw input_error(desc.path, "camera \"up\" must not be parallel to the viewing direction");

@@ -94,8 +94,8 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
     ctx.fail("fov_y_deg", "\"fov_y_deg\" must be in (0, 179) degrees");
   vec3f dir = cam.target - cam.eye;
   bool both = has_eye && has_target;  // otherwise checked once the mesh bounds are known (scene.cpp)
-  if (both && !(length(dir) > 0)) ctx.fail("target", "camera \"eye\" and \"target\" must differ");
-  if (!(length(cam.up) > 0)) ctx.fail("up", "camera \"up\" must be a non-zero vector");
+  if (both && !(length(normalize(dir)) > 0)) ctx.fail("target", "camera \"eye\" and \"target\" must differ");
+  if (!(length(normalize(cam.up)) > 0)) ctx.fail("up", "camera \"up\" must be a non-zero vector");
   if (both && !(length(cross(normalize(dir), normalize(cam.up))) > 1e-6f))
     ctx.fail("up", "camera \"up\" must not be parallel to the viewing direction");
 }
@@ -106,11 +106,11 @@ void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
     ctx.fail("sun", "\"sun\" needs \"direction\" and \"irradiance\"");
   sun.enabled = true;
   vec3f d = get_vec3(ctx, j["direction"], "direction");
-  if (!(length(d) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
+  if (!(length(normalize(d)) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
   sun.direction = normalize(d);
   if (j.contains("direction_end")) {
     vec3f e = get_vec3(ctx, j["direction_end"], "direction_end");
-    if (!(length(e) > 0)) ctx.fail("direction_end", "sun \"direction_end\" must be a non-zero vector");
+    if (!(length(normalize(e)) > 0)) ctx.fail("direction_end", "sun \"direction_end\" must be a non-zero vector");
     sun.direction_end = normalize(e);
     sun.animated = true;
   }

@@ -226,6 +226,51 @@ TEST_CASE("a camera given in part takes the framing of a bare OBJ for the rest",
   CHECK(eye.pixels != read_image(s.dir / "bare.pfm").pixels);
 }
 
+TEST_CASE("directions of any finite length point the same way", "[cli]") {
+  // SPEC 3: the sun's direction is normalised on load. A direction scaled by 1e20 or 1e-25 (its squared length
+  // outside float's range) renders the image of the unit one; the camera's "up" likewise.
+  tiny_scene s;
+  auto render_with = [&](const std::string& name, const std::string& sun, const std::string& up) {
+    write_text(s.dir / (name + ".json"),
+               "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], \"target\": [0, 0, 0], \"up\": " + up +
+                   "}, \"sun\": {\"direction\": " + sun + ", \"irradiance\": [2, 2, 2]}}");
+    auto r = run_bayeslight("render " + (s.dir / (name + ".json")) + " --spp 2 --width 8 --height 6 --quiet -o " +
+                            (s.dir / (name + ".pfm")));
+    INFO(name << "\n" << r.output);
+    REQUIRE(r.status == 0);
+    return read_image(s.dir / (name + ".pfm")).pixels;
+  };
+  std::vector<float> unit = render_with("unit", "[0.3, 1, 0.2]", "[0, 1, 0]");
+  CHECK(render_with("long", "[3e19, 1e20, 2e19]", "[0, 1e20, 0]") == unit);
+  CHECK(render_with("short", "[3e-26, 1e-25, 2e-26]", "[0, 1e-25, 0]") == unit);
+  CHECK(render_with("other", "[-0.3, 1, 0.2]", "[0, 1, 0]") != unit);  // the sun matters in this scene
+}
+
+TEST_CASE("a sun of any positive diameter gives its irradiance", "[cli]") {
+  // SPEC 3 allows any angular_diameter_deg > 0. A disk far below a pixel's size lights the floor as a slightly larger
+  // one does (its irradiance is given), not black, NaN or infinite.
+  tiny_scene s;
+  auto mean_of = [&](const std::string& name, const std::string& diameter) {
+    write_text(s.dir / (name + ".json"), "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], \"target\": [0, 0, 0]},"
+                                         " \"sun\": {\"direction\": [0.3, 1, 0.2], \"irradiance\": [2, 2, 2],"
+                                         " \"angular_diameter_deg\": " + diameter + "}}");
+    auto r = run_bayeslight("render " + (s.dir / (name + ".json")) + " --spp 4 --width 8 --height 6 --max-depth 1"
+                            " --quiet -o " + (s.dir / (name + ".pfm")));
+    INFO(name << "\n" << r.output);
+    REQUIRE(r.status == 0);
+    double sum = 0;
+    for (float v : read_image(s.dir / (name + ".pfm")).pixels) sum += v;
+    return sum;
+  };
+  double small = mean_of("small", "0.001");
+  REQUIRE(small > 0);
+  REQUIRE(std::isfinite(small));
+  for (const char* d : {"1e-10", "1e-18", "1e-30"}) {
+    INFO("diameter " << d);
+    CHECK(mean_of("tiny", d) == Approx(small).epsilon(1e-3));
+  }
+}
+
 TEST_CASE("outputs that would overwrite an input or each other are refused before rendering", "[cli]") {
   tiny_scene s;
   write_text(s.dir / "tex.mtl", "newmtl floor\nKd 0.5 0.5 0.5\nmap_Kd floor.png\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n");

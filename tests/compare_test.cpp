@@ -299,7 +299,7 @@ void check_outputs(const std::string& out, const std::vector<std::string>& sampl
 
 TEST_CASE("compare at equal spp writes curves summary plot and images", "[compare]") {
   compare_scene s;
-  std::string out = s.dir / "out";  // does not exist yet: compare creates it
+  std::string out = s.dir / "out" + "/run";  // neither exists yet: compare creates both, as mkdir -p
   run_result r = run_bayeslight("compare " + s.json + " --reference " + s.ref +
                                 " --spp 4 --samplers uniform,power,bvh --out " + out + " --threads 2 --quiet");
   INFO(r.output);
