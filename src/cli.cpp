@@ -151,8 +151,14 @@ int run_render(const render_options& o) {
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
   std::vector<std::string> outputs = o.outputs;
-  if (outputs.empty())
-    outputs.push_back(fs::path(o.scene).stem().string() + (o.frames > 1 ? "_%04d.exr" : ".exr"));
+  if (outputs.empty()) {
+    // SCENE.exr in the working directory ("dir/" names dir: the scene load then says what is wrong with it).
+    fs::path scene = fs::path(o.scene).lexically_normal();
+    if (!scene.has_filename()) scene = scene.parent_path();
+    std::string stem = scene.stem().string();
+    outputs.push_back((stem.empty() || stem == "." || stem == ".." ? "render" : stem) +
+                      (o.frames > 1 ? "_%04d.exr" : ".exr"));
+  }
   for (const std::string& out : outputs)
     if (image_format_of(out) == image_format::unknown)
       throw usage_error("output " + out + ": unknown image format (use .exr, .pfm or .png)");

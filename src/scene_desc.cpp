@@ -64,10 +64,19 @@ float get_number(const desc_context& ctx, const json& v, const std::string& key)
 
 // An integer in [lo, hi].
 int64_t get_integer(const desc_context& ctx, const json& v, const std::string& key, int64_t lo, int64_t hi) {
-  if (!v.is_number_integer()) ctx.fail(key, "\"" + key + "\" must be an integer");
-  if (v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(std::numeric_limits<int64_t>::max()))
-    ctx.fail(key, "\"" + key + "\" is out of range");
-  int64_t i = v.get<int64_t>();
+  int64_t i;
+  if (v.is_number_float()) {
+    // A whole number written with a fraction or exponent (64.0, 1e3: what many JSON writers emit) is that integer.
+    double d = v.get<double>();
+    if (!(std::floor(d) == d)) ctx.fail(key, "\"" + key + "\" must be an integer");
+    if (!(std::fabs(d) <= 9007199254740992.0)) ctx.fail(key, "\"" + key + "\" is out of range");
+    i = int64_t(d);
+  } else {
+    if (!v.is_number_integer()) ctx.fail(key, "\"" + key + "\" must be an integer");
+    if (v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(std::numeric_limits<int64_t>::max()))
+      ctx.fail(key, "\"" + key + "\" is out of range");
+    i = v.get<int64_t>();
+  }
   if (i < lo || i > hi)
     ctx.fail(key, "\"" + key + "\" must be between " + std::to_string(lo) + " and " + std::to_string(hi) +
                       " (got " + std::to_string(i) + ")");
@@ -196,6 +205,8 @@ scene_desc load_scene_desc(const std::string& path) {
   if (!root.contains("mesh")) throw input_error(path, "missing required key \"mesh\"");
   if (!root["mesh"].is_string() || root["mesh"].get<std::string>().empty())
     ctx.fail("mesh", "\"mesh\" must be a non-empty string (a path to an .obj file)");
+  if (root["mesh"].get<std::string>().find('\0') != std::string::npos)
+    ctx.fail("mesh", "\"mesh\" must not contain a NUL character (\\u0000)");
   fs::path mesh = root["mesh"].get<std::string>();
   desc.mesh_path = mesh.is_absolute() ? mesh.string() : (fs::path(path).parent_path() / mesh).string();
 

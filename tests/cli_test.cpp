@@ -165,6 +165,8 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
       // An eye without a target looks at the mesh's centre: not from the centre itself.
       {"eye_at_centre.json", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 0]}}", "eye_at_centre.json"},
       {"seed_range.json", "{\"mesh\": \"box.obj\", \"render\": {\"seed\": -1}}", "seed_range.json:1: \"seed\""},
+      {"fraction.json", "{\"mesh\": \"box.obj\", \"render\": {\"spp\": 2.5}}", "fraction.json:1: \"spp\" must be an integer"},
+      {"nul.json", "{\"mesh\": \"box.obj\\u0000junk\"}", "nul.json:1: \"mesh\" must not contain a NUL"},
   };
   write_text(s.dir / "bad.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n");
   for (const auto& c : cases) {
@@ -244,6 +246,19 @@ TEST_CASE("directions of any finite length point the same way", "[cli]") {
   CHECK(render_with("long", "[3e19, 1e20, 2e19]", "[0, 1e20, 0]") == unit);
   CHECK(render_with("short", "[3e-26, 1e-25, 2e-26]", "[0, 1e-25, 0]") == unit);
   CHECK(render_with("other", "[-0.3, 1, 0.2]", "[0, 1, 0]") != unit);  // the sun matters in this scene
+}
+
+TEST_CASE("whole numbers written with a fraction or exponent are integers", "[cli]") {
+  // Many JSON writers emit 64.0 for an integer-valued number: the scene means 64.
+  tiny_scene s;
+  write_text(s.dir / "float.json", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], \"target\": [0, 0, 0]},"
+                                   " \"image\": {\"width\": 16.0, \"height\": 1.2e1}, \"render\": {\"spp\": 2.0, \"max_depth\": 2e0}}");
+  auto a = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "int.pfm"));
+  auto b = run_bayeslight("render " + (s.dir / "float.json") + " --quiet -o " + (s.dir / "float.pfm"));
+  INFO(a.output << b.output);
+  REQUIRE(a.status == 0);
+  REQUIRE(b.status == 0);
+  CHECK(read_image(s.dir / "float.pfm").pixels == read_image(s.dir / "int.pfm").pixels);
 }
 
 TEST_CASE("a sun of any positive diameter gives its irradiance", "[cli]") {
@@ -356,6 +371,14 @@ TEST_CASE("inputs that are not regular files are refused, never read", "[cli]") 
     INFO(args << "\n" << r.output);
     CHECK(r.status == 3);
     CHECK(r.output.find("not a regular file") != std::string::npos);
+  }
+  // A directory given as the scene, with or without a trailing slash and without -o (whose default name comes from
+  // the scene's): bad input, exit 3, naming it.
+  for (const std::string& dir : {s.dir.path.string(), s.dir.path.string() + "/"}) {
+    auto r = run_bayeslight("render " + dir + " --quiet");
+    INFO(dir << "\n" << r.output);
+    CHECK(r.status == 3);
+    CHECK(r.output.find(dir + ":") != std::string::npos);
   }
 }
 
