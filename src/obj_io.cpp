@@ -370,8 +370,9 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
       break;
     }
   mesh.source_files.push_back(path);
-  for (const auto& m : clean.materials)
-    if (std::find(mesh.source_files.begin(), mesh.source_files.end(), m.mtl_path) == mesh.source_files.end())
+  for (const auto& m : clean.materials)  // (an undefined material, given the default, has no MTL file)
+    if (!m.mtl_path.empty() &&
+        std::find(mesh.source_files.begin(), mesh.source_files.end(), m.mtl_path) == mesh.source_files.end())
       mesh.source_files.push_back(m.mtl_path);
   for (const texture_data& t : mesh.textures) mesh.source_files.push_back(t.path);
   return mesh;

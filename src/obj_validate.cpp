@@ -449,9 +449,18 @@ obj_clean_data validate_obj(const std::string& path) {
   for (size_t i = 0; i < st.defined.size(); i++) defined_index.emplace(st.defined[i].material.name, int(i));
   for (size_t k = 0; k < st.used_names.size(); k++) {
     auto it = defined_index.find(st.used_names[k]);
-    if (it == defined_index.end())
-      fail(text_pos{path, st.used_lines[k]}, "usemtl of undefined material " + quote(st.used_names[k]));
-    d.materials.push_back(st.defined[size_t(it->second)]);
+    if (it != defined_index.end()) {
+      d.materials.push_back(st.defined[size_t(it->second)]);
+    } else {
+      // As other OBJ readers do (tinyobjloader, Blender): the faces get the default material (Kd 0.8), said once per
+      // name. OBJ files often outlive or lose their MTL's entries, or name materials with no mtllib at all.
+      std::cerr << "warning: " << path << ":" << st.used_lines[k] << ": usemtl of undefined material "
+                << quote(st.used_names[k])
+                << (st.defined.empty() ? " (no material library defines any)" : "")
+                << ": its faces get the default material (Kd 0.8)\n";
+      d.materials.emplace_back();
+      d.materials.back().material.name = st.used_names[k];
+    }
     d.mtl_text += "newmtl u" + std::to_string(k) + "\n";
   }
   d.obj_text = d.materials.empty() ? std::move(body) : "mtllib used.mtl\n" + body;

@@ -390,6 +390,14 @@ TEST_CASE("materials the renderer changes or ignores are named in a warning", "[
   REQUIRE(r.status == 0);
   CHECK(r.output.find("material 'floor' has Kd + Ks above 1, scaled down to conserve energy") != std::string::npos);
   CHECK(r.output.find("box.mtl:4: dissolve") != std::string::npos);
+  // A material the library does not define: its faces get the default material, said at the usemtl's line. The
+  // lamp named so no longer emits: the image is black where it was lit.
+  write_text(s.dir / "box.mtl", "newmtl floor\nKd 0.5 0.5 0.5\n");
+  r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "o.pfm"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("box.obj:12: usemtl of undefined material 'lamp': its faces get the default material") !=
+        std::string::npos);
 }
 
 TEST_CASE("an unwritable output is reported before rendering", "[cli]") {

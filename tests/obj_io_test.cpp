@@ -351,15 +351,29 @@ TEST_CASE("material library errors name the MTL file and line", "[obj]") {
   CHECK_THAT(load_error(obj_for("newmtl\n")), Catch::Contains(mtl + ":1: newmtl needs a material name"));
 }
 
-TEST_CASE("a missing MTL or undefined material is an input error at its OBJ line", "[obj]") {
+TEST_CASE("a missing MTL is an input error at its OBJ line; an undefined material gets the default", "[obj]") {
   temp_dir dir;
   auto obj = dir.write("a.obj", std::string(square_vertices) + "mtllib missing.mtl\nf 1 2 3\n");
   CHECK_THAT(load_error(obj),
              Catch::Contains(obj + ":5: mtllib: ") && Catch::Contains("missing.mtl: cannot open material library"));
-  dir.write("ok.mtl", "newmtl known\n");
-  obj = dir.write("b.obj",
-                  "mtllib ok.mtl\n" + std::string(square_vertices) + "usemtl known\nf 1 2 3\nusemtl ghost\nf 1 3 4\n");
-  CHECK_THAT(load_error(obj), Catch::Contains(obj + ":8: usemtl of undefined material 'ghost'"));
+  // As other OBJ readers do: faces of a name no library defines (with a library, or with none at all) render with
+  // the default material (a warning names the line; checked in cli_test).
+  dir.write("ok.mtl", "newmtl known\nKd 0.25 0.5 0.75\n");
+  for (std::string lib : {"mtllib ok.mtl\n", ""}) {
+    obj = dir.write("b.obj", lib + std::string(square_vertices) + "usemtl known\nf 1 2 3\nusemtl ghost\nf 1 3 4\n");
+    INFO(lib);
+    mesh_data m = load_obj(obj);
+    REQUIRE(m.tri_materials.size() == 2);
+    const material_data& known = m.materials[size_t(m.tri_materials[0])];
+    const material_data& ghost = m.materials[size_t(m.tri_materials[1])];
+    CHECK(ghost.name == "ghost");
+    CHECK(ghost.kd.x == material_data{}.kd.x);
+    CHECK(ghost.kd.z == material_data{}.kd.z);
+    CHECK(ghost.ke.x == 0);
+    CHECK(known.name == "known");
+    CHECK(known.kd.z == (lib.empty() ? material_data{}.kd.z : 0.75f));
+    CHECK(m.source_files.size() == (lib.empty() ? 1u : 2u));  // the OBJ (and its library): no empty name
+  }
 }
 
 TEST_CASE("a missing or undecodable texture is an input error at its MTL line", "[obj]") {
