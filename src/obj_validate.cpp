@@ -175,9 +175,19 @@ static void check_index(string_view t, int count, const char* what, const text_p
 }
 
 // Checks one face corner: v, v/vt, v//vn or v/vt/vn.
-static void check_corner(string_view c, const obj_clean_data& d, const text_pos& pos) {
+// Returns the corner as tinyobjloader is given it: an empty trailing part dropped with its slash ("1/" and "1//" are
+// "1", "1/2/" is "1/2", as other OBJ readers take them).
+static string_view check_corner(string_view c, const obj_clean_data& d, const text_pos& pos) {
   size_t s1 = c.find('/');
-  if (s1 == string_view::npos) return check_index(c, int(d.positions.size()), "vertex", pos);
+  if (s1 != string_view::npos && c.size() >= 2 && c.substr(c.size() - 2) == "//" && c.find('/') == c.size() - 2)
+    c = c.substr(0, c.size() - 2);  // v//
+  else if (s1 != string_view::npos && c.back() == '/' && std::count(c.begin(), c.end(), '/') <= 2)
+    c = c.substr(0, c.size() - 1);  // v/ or v/vt/
+  s1 = c.find('/');
+  if (s1 == string_view::npos) {
+    check_index(c, int(d.positions.size()), "vertex", pos);
+    return c;
+  }
   size_t s2 = c.find('/', s1 + 1);
   if (s2 != string_view::npos && c.find('/', s2 + 1) != string_view::npos)
     fail(pos, "malformed face corner " + quote(c) + " (expected v, v/vt, v//vn or v/vt/vn)");
@@ -185,6 +195,7 @@ static void check_corner(string_view c, const obj_clean_data& d, const text_pos&
   string_view vt = c.substr(s1 + 1, s2 == string_view::npos ? string_view::npos : s2 - s1 - 1);
   if (s2 == string_view::npos || !vt.empty()) check_index(vt, int(d.texcoords.size()), "texcoord", pos);
   if (s2 != string_view::npos) check_index(c.substr(s2 + 1), int(d.normals.size()), "normal", pos);
+  return c;
 }
 
 // Counts unrecognised statements of one file and reports them once.
@@ -417,8 +428,7 @@ obj_clean_data validate_obj(const std::string& path) {
       if (args > size_t(INT_MAX / 4)) fail(pos, "face has too many vertices");
       body += 'f';
       for (size_t i = 1; i <= args; i++) {
-        check_corner(t[i], d, pos);
-        (body += ' ') += t[i];
+        (body += ' ') += check_corner(t[i], d, pos);
       }
       body += '\n';
       d.face_sizes.push_back(int(args));

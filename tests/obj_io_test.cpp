@@ -161,6 +161,23 @@ TEST_CASE("corners of the forms v//vn and v/vt/vn carry unit normals and texcoor
   CHECK(m.tri_normals[5] == invalid_id);
 }
 
+TEST_CASE("a corner's empty trailing part is left out as if not written", "[obj]") {
+  // Some exporters end a corner with its slash ("1/", "1//", "1/2/"): the same mesh as without it.
+  temp_dir dir;
+  const std::string head = std::string(square_vertices) + "vt 0.25 0.5\nvt 0.75 0.5\n";
+  mesh_data a = load_obj(dir.write("a.obj", head + "f 1/ 2// 3\nf 1/1/ 3/2/ 4/1\n"));
+  mesh_data b = load_obj(dir.write("b.obj", head + "f 1 2 3\nf 1/1 3/2 4/1\n"));
+  check_invariants(a);
+  CHECK(a.tri_positions == b.tri_positions);
+  CHECK(a.tri_texcoords == b.tri_texcoords);
+  CHECK(a.tri_normals == b.tri_normals);
+  REQUIRE(a.tri_texcoords.size() == 6);
+  CHECK(a.tri_texcoords[0] == invalid_id);
+  CHECK(a.texcoords[size_t(a.tri_texcoords[4])].x == 0.75f);
+  // Only one empty part may go: three slashes stay malformed.
+  CHECK_THAT(load_error(dir.write("c.obj", head + "f 1/1/1/ 2 3\n")), Catch::Contains("c.obj:7: malformed face corner"));
+}
+
 TEST_CASE("materials read Kd Ks Ns and Ke and faces without one get the default", "[obj]") {
   temp_dir dir;
   dir.write("m.mtl",
@@ -313,7 +330,7 @@ TEST_CASE("malformed statements are input errors with file and line", "[obj]") {
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/1 2/1 3/1\n", 4, "texcoord index '1' out of range"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2 3\n", 4, "normal index '1' out of range"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3.0\n", 4, "malformed vertex index '3.0'"},
-      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/\n", 4, "malformed texcoord index ''"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 /3\n", 4, "malformed vertex index ''"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/1/1/1\n", 4, "malformed face corner"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", 4, "out of range"},
       {"v 0 0 0\nv 1 0 0\nf 1 2\n", 3, "at least 3 vertices"},
