@@ -157,30 +157,11 @@ static bool unit_normal(vec3f vn, vec3f& out) {
   return is_finite(out) && length_sq(out) > 0;
 }
 
-// The path of texture `name` named in MTL file mtl_path (relative names are relative to its folder;
-// Windows separators are tried as '/' when the name as written is not a file).
-static std::string texture_path(const std::string& mtl_path, const std::string& name) {
-  auto resolve = [&](const std::string& nm) {
-    fs::path q(nm);
-    if (!q.is_absolute()) q = fs::path(mtl_path).parent_path() / q;
-    return q.lexically_normal().string();
-  };
-  std::string path = resolve(name);
-  std::error_code ec;
-  if (name.find('\\') != std::string::npos && !fs::exists(path, ec)) {
-    std::string slashed = name;
-    for (char& ch : slashed) ch = ch == '\\' ? '/' : ch;
-    std::string alt = resolve(slashed);
-    if (fs::exists(alt, ec)) return alt;
-  }
-  return path;
-}
-
 // Index of the texture for (mtl, line, name) in mesh.textures, loading it on first use of its path.
 static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, const std::string& mtl_path, int line,
                          const char* statement, const std::string& name) {
   if (name.empty()) return invalid_id;
-  std::string path = texture_path(mtl_path, name);
+  std::string path = resolve_file_name(fs::path(mtl_path).parent_path().string(), name);
   auto it = loaded.find(path);
   if (it != loaded.end()) return it->second;
   try {

@@ -213,11 +213,23 @@ struct unknown_log {
   }
 };
 
-// The path of file name `name` written in a file inside folder `dir`.
-static std::string resolve_path(const std::string& dir, const std::string& name) {
-  fs::path p(name);
-  if (!p.is_absolute() && !dir.empty()) p = fs::path(dir) / p;
-  return p.lexically_normal().string();
+std::string resolve_file_name(const std::string& dir, const std::string& written) {
+  std::string name = written;
+  if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = name.substr(1, name.size() - 2);
+  auto resolve = [&](const std::string& nm) {
+    fs::path p(nm);
+    if (!p.is_absolute() && !dir.empty()) p = fs::path(dir) / p;
+    return p.lexically_normal().string();
+  };
+  std::string path = resolve(name);
+  std::error_code ec;
+  if (name.find('\\') != std::string::npos && !fs::exists(path, ec)) {
+    std::string slashed = name;
+    std::replace(slashed.begin(), slashed.end(), '\\', '/');
+    std::string alt = resolve(slashed);
+    if (fs::exists(alt, ec)) return alt;
+  }
+  return path;
 }
 
 // Number of numeric arguments (min, max) of a texture option, or min = -1 when it takes one word.
@@ -366,13 +378,13 @@ static void handle_mtllib(const std::vector<string_view>& t, const std::string& 
   std::vector<std::string> names;
   std::string whole = join_from(t, 1);
   std::error_code ec;
-  if (t.size() > 2 && fs::is_regular_file(resolve_path(dir, whole), ec)) {
+  if (t.size() > 2 && fs::is_regular_file(resolve_file_name(dir, whole), ec)) {
     names.push_back(whole);  // one file name with spaces in it
   } else {
     for (size_t i = 1; i < t.size(); i++) names.emplace_back(t[i]);
   }
   for (const auto& name : names) {
-    std::string file = resolve_path(dir, name);
+    std::string file = resolve_file_name(dir, name);
     if (!st.mtl_files.insert(file).second) continue;
     try {
       validate_mtl(file, st.defined);

@@ -40,6 +40,11 @@ constexpr int max_number_chars = 128;
 // Reads and validates the OBJ at path and its MTL libraries; throws input_error naming file and line.
 obj_clean_data validate_obj(const std::string& path);
 
+// The path of a file named `written` in a file inside folder `dir` (mtllib, map_Kd, map_d): relative names are
+// relative to dir; one pair of surrounding double quotes is dropped; Windows separators ('\\') are tried as '/'
+// when the name as written is not a file.
+std::string resolve_file_name(const std::string& dir, const std::string& written);
+
 // Reads a whole regular file; throws input_error (naming what, e.g. "material library") when it cannot.
 std::string read_text_file(const std::string& path, const char* what);
 

@@ -258,6 +258,25 @@ TEST_CASE("map_Kd and map_d are resolved beside the MTL and decoded once", "[obj
   CHECK(eval_texture_alpha(t, {0.9f, 0.5f}) == 0.0f);
 }
 
+TEST_CASE("library and texture names may be quoted or use Windows separators", "[obj]") {
+  // mtllib, map_Kd and map_d resolve names alike: one pair of surrounding double quotes is dropped (a name with a
+  // space), and '\\' is tried as '/' when the name as written is not a file.
+  temp_dir dir;
+  std::filesystem::create_directory(dir.path + "/my mats");
+  std::filesystem::create_directory(dir.path + "/my mats/tex");
+  write_png(dir, "my mats/tex/a b.png");
+  dir.write("my mats/lib.mtl", "newmtl leaf\nmap_Kd \"tex/a b.png\"\nmap_d tex\\a b.png\n");
+  for (std::string lib : {"mtllib \"my mats/lib.mtl\"\n", "mtllib my mats\\lib.mtl\n"}) {
+    INFO(lib);
+    auto obj = dir.write("q.obj", lib + std::string(square_vertices) + "vt 0.25 0.5\nusemtl leaf\nf 1/1 2/1 3/1\n");
+    mesh_data m = load_obj(obj);
+    REQUIRE(m.textures.size() == 1);
+    CHECK(m.textures[0].path == dir.path + "/my mats/tex/a b.png");
+    CHECK(m.materials[0].kd_texture == 0);
+    CHECK(m.materials[0].alpha_texture == 0);
+  }
+}
+
 TEST_CASE("degenerate triangles are dropped and counted", "[obj]") {
   temp_dir dir;
   auto obj = dir.write("deg.obj", std::string(square_vertices) +
