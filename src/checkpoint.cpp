@@ -259,8 +259,9 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   }
   for (const texture_data& t : m.textures) {
     h.value(t.width), h.value(t.height);
-    h.column(t.rgb);
-    h.column(t.alpha);
+    h.value(t.channels);
+    h.column(t.texels8);
+    h.column(t.texels16);
   }
   h.vec(scene.camera.eye), h.vec(scene.camera.target), h.vec(scene.camera.up), h.value(scene.camera.fov_y_deg);
   h.value(scene.sun.enabled), h.vec(scene.sun.direction), h.vec(scene.sun.irradiance);

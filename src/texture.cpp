@@ -151,25 +151,33 @@ struct stbi_deleter {
   void operator()(void* p) const { stbi_image_free(p); }
 };
 
-// Fills rgb and alpha of tex from n-channel pixels (8- or 16-bit); colour goes through to_linear[value].
-template <typename T>
-static void fill_texels(texture_data& tex, const T* px, int n, const std::vector<float>& to_linear) {
-  const float inv_max = 1.0f / float(std::numeric_limits<T>::max());
-  size_t count = size_t(tex.width) * size_t(tex.height);
-  tex.rgb.resize(count);
-  tex.alpha.resize(count);
-  for (size_t i = 0; i < count; i++) {
-    const T* p = px + i * size_t(n);
-    if (n >= 3) {
-      tex.rgb[i] = {to_linear[p[0]], to_linear[p[1]], to_linear[p[2]]};
-    } else {
-      float g = to_linear[p[0]];
-      tex.rgb[i] = {g, g, g};
-    }
-    // Alpha channel when there is one (2 or 4 channels), else the first channel (a greyscale mask).
-    T a = (n == 2 || n == 4) ? p[n - 1] : p[0];
-    tex.alpha[i] = float(a) * inv_max;
-  }
+// The colour decode tables: 8-bit values through srgb8_to_linear, 16-bit ones through the same curve in float.
+static const float* table8() {
+  static const std::vector<float> t = [] {
+    std::vector<float> v(256);
+    for (int i = 0; i < 256; i++) v[size_t(i)] = srgb8_to_linear((unsigned char)i);
+    return v;
+  }();
+  return t.data();
+}
+static const float* table16() {
+  static const std::vector<float> t = [] {
+    std::vector<float> v(65536);
+    for (int i = 0; i < 65536; i++) v[size_t(i)] = srgb_to_linear(float(i) / 65535.0f);
+    return v;
+  }();
+  return t.data();
+}
+
+texture_data texture_from_texels8(std::string path, int width, int height, int channels, std::vector<uint8_t> texels) {
+  texture_data t;
+  t.path = std::move(path);
+  t.width = width;
+  t.height = height;
+  t.channels = channels;
+  t.texels8 = std::move(texels);
+  t.to_linear = table8();
+  return t;
 }
 
 texture_data load_texture(const std::string& path) {
@@ -210,20 +218,17 @@ texture_data load_texture(const std::string& path) {
     std::unique_ptr<stbi_us, stbi_deleter> px(stbi_load_16_from_memory(data, len, &dw, &dh, &dn, 0));
     if (!px) throw input_error(path, "cannot decode image: " + stb_reason());
     if (dw != w || dh != h || dn < 1 || dn > 4) throw input_error(path, "cannot decode image: inconsistent header");
-    std::vector<float> table(65536);
-    for (int v = 0; v < 65536; v++) table[v] = srgb_to_linear(float(v) / 65535.0f);
     tex.width = dw;
     tex.height = dh;
-    fill_texels(tex, px.get(), dn, table);
+    tex.channels = dn;
+    tex.texels16.assign(px.get(), px.get() + size_t(dw) * size_t(dh) * size_t(dn));
+    tex.to_linear = table16();
   } else {
     std::unique_ptr<stbi_uc, stbi_deleter> px(stbi_load_from_memory(data, len, &dw, &dh, &dn, 0));
     if (!px) throw input_error(path, "cannot decode image: " + stb_reason());
     if (dw != w || dh != h || dn < 1 || dn > 4) throw input_error(path, "cannot decode image: inconsistent header");
-    std::vector<float> table(256);
-    for (int v = 0; v < 256; v++) table[v] = srgb8_to_linear((unsigned char)v);
-    tex.width = dw;
-    tex.height = dh;
-    fill_texels(tex, px.get(), dn, table);
+    tex = texture_from_texels8(path, dw, dh, dn,
+                               std::vector<uint8_t>(px.get(), px.get() + size_t(dw) * size_t(dh) * size_t(dn)));
   }
   return tex;
 }
@@ -254,24 +259,24 @@ static int axis_nearest(float f, int n) {
 }
 
 vec3f eval_texture_rgb(const texture_data& tex, vec2f uv) {
-  if (tex.width <= 0 || tex.height <= 0 || tex.rgb.size() != size_t(tex.width) * size_t(tex.height)) return {0, 0, 0};
+  if (!texture_complete(tex)) return {0, 0, 0};
   int x0, x1, b0, b1;
   float wx, wb;
   axis_footprint(wrap01(uv.x), tex.width, x0, x1, wx);
   // v counts rows from the bottom: bottom-based row b is image row height - 1 - b.
   axis_footprint(wrap01(uv.y), tex.height, b0, b1, wb);
   int y0 = tex.height - 1 - b0, y1 = tex.height - 1 - b1;
-  auto at = [&](int x, int y) { return tex.rgb[size_t(y) * size_t(tex.width) + size_t(x)]; };
+  auto at = [&](int x, int y) { return texel_rgb(tex, size_t(y) * size_t(tex.width) + size_t(x)); };
   vec3f lo = at(x0, y0) * (1.0f - wx) + at(x1, y0) * wx;
   vec3f hi = at(x0, y1) * (1.0f - wx) + at(x1, y1) * wx;
   return lo * (1.0f - wb) + hi * wb;
 }
 
 float eval_texture_alpha(const texture_data& tex, vec2f uv) {
-  if (tex.width <= 0 || tex.height <= 0 || tex.alpha.size() != size_t(tex.width) * size_t(tex.height)) return 1.0f;
+  if (!texture_complete(tex)) return 1.0f;
   int x = axis_nearest(wrap01(uv.x), tex.width);
   int y = tex.height - 1 - axis_nearest(wrap01(uv.y), tex.height);
-  return tex.alpha[size_t(y) * size_t(tex.width) + size_t(x)];
+  return texel_alpha(tex, size_t(y) * size_t(tex.width) + size_t(x));
 }
 
 }  // namespace bl

@@ -1,9 +1,10 @@
 // texture: image textures of OBJ materials (map_Kd diffuse colour, map_d alpha cut-out mask).
-// Invariants: texels are stored linear (8-bit sRGB images are decoded through a fixed float table), top row
-// first; lookups wrap (repeat) in u and v, with v = 0 at the bottom of the image as in OBJ. All maths is
+// Invariants: texels are stored as the file's 8- or 16-bit values and decoded to linear through fixed float tables,
+// top row first; lookups wrap (repeat) in u and v, with v = 0 at the bottom of the image as in OBJ. All maths is
 // float (powf for the sRGB tables, floorf for wrapping), so textures decode and filter identically on any CPU.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -11,23 +12,53 @@
 
 namespace bl {
 
-// Largest accepted image (width * height); 2^27 texels is 2 GiB of decoded rgb + alpha.
+// Largest accepted image (width * height); 2^27 texels is 512 MiB of 8-bit RGBA (1 GiB at 16 bits).
 constexpr long long max_texture_texels = 1LL << 27;
 
-// One decoded texture. rgb is linear; alpha is the cut-out mask in [0, 1] (from the alpha channel when the
-// image has one, else from its first channel). Both have width*height entries, row-major, top row first.
+// One decoded texture, kept as the file's own 8- or 16-bit channels (a quarter of the memory of float RGB + alpha:
+// a 4096² RGBA texture takes 64 MiB), decoded per lookup through a fixed table: texel_rgb is linear RGB, texel_alpha
+// the cut-out mask in [0, 1] (from the alpha channel when the image has one, else from its first channel).
+// Texels are row-major, top row first.
 struct texture_data {
   std::string path;
   int width = 0, height = 0;
-  std::vector<vec3f> rgb;
-  std::vector<float> alpha;
+  int channels = 0;                   // 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA
+  std::vector<uint8_t> texels8;       // 8-bit images: width * height * channels values
+  std::vector<uint16_t> texels16;     // 16-bit images (then texels8 is empty)
+  const float* to_linear = nullptr;   // the colour decode table of the bit depth (256 or 65536 entries)
 };
+
+// Linear RGB and alpha mask of texel i (row-major index); the texture must hold width * height texels.
+inline vec3f texel_rgb(const texture_data& t, size_t i) {
+  size_t c = i * size_t(t.channels);
+  if (!t.texels8.empty()) {
+    const uint8_t* p = t.texels8.data() + c;
+    return t.channels >= 3 ? vec3f{t.to_linear[p[0]], t.to_linear[p[1]], t.to_linear[p[2]]}
+                           : vec3f{t.to_linear[p[0]], t.to_linear[p[0]], t.to_linear[p[0]]};
+  }
+  const uint16_t* p = t.texels16.data() + c;
+  return t.channels >= 3 ? vec3f{t.to_linear[p[0]], t.to_linear[p[1]], t.to_linear[p[2]]}
+                         : vec3f{t.to_linear[p[0]], t.to_linear[p[0]], t.to_linear[p[0]]};
+}
+inline float texel_alpha(const texture_data& t, size_t i) {
+  size_t a = i * size_t(t.channels) + size_t(t.channels == 2 || t.channels == 4 ? t.channels - 1 : 0);
+  if (!t.texels8.empty()) return float(t.texels8[a]) * (1.0f / 255.0f);
+  return float(t.texels16[a]) * (1.0f / 65535.0f);
+}
+// Whether t holds all its texels (a default-constructed texture holds none).
+inline bool texture_complete(const texture_data& t) {
+  size_t n = size_t(t.width) * size_t(t.height) * size_t(t.channels);
+  return t.width > 0 && t.height > 0 && t.to_linear && (t.texels8.size() == n || t.texels16.size() == n) && n > 0;
+}
 
 // Loads an image file (PNG, JPEG, TGA, BMP via stb_image); throws input_error naming the file on failure.
 // 8-bit colour goes through the srgb8_to_linear table, 16-bit colour through the same sRGB curve in float;
 // alpha is linear (value / max). HDR, GIF, PSD, PIC and PNM files are refused, as are images larger than
 // max_texture_texels.
 texture_data load_texture(const std::string& path);
+
+// A texture of 8-bit texels (width * height * channels values, row-major, top row first; colour sRGB-encoded).
+texture_data texture_from_texels8(std::string path, int width, int height, int channels, std::vector<uint8_t> texels);
 
 // Linear RGB at texture coordinate uv (bilinear, repeat wrap).
 vec3f eval_texture_rgb(const texture_data& tex, vec2f uv);

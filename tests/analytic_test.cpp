@@ -105,11 +105,8 @@ TEST_CASE("the holes of an emitter's own map_d emit nothing", "[analytic]") {
         b.mesh.tri_texcoords[k] = int(b.mesh.texcoords.size());
         b.mesh.texcoords.push_back({(p.x + a) / (2 * a), (p.z + a) / (2 * a)});
       }
-      texture_data mask;
-      mask.width = 2, mask.height = 1;
-      mask.rgb.assign(2, vec3f{1, 1, 1});
-      mask.alpha = {1.0f, 0.0f};
-      b.mesh.textures.push_back(mask);
+      // Two texels of grey + alpha: white, opaque then a hole.
+      b.mesh.textures.push_back(texture_from_texels8("mask", 2, 1, 2, {255, 255, 255, 0}));
       b.mesh.materials[size_t(lamp)].alpha_texture = 0;
       double exact = 0.5 * under_square_lamp(a, h, le, rho);
       INFO("sampler " << sampler_name(kind) << " depth " << depth);

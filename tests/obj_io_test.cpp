@@ -252,9 +252,9 @@ TEST_CASE("map_Kd and map_d are resolved beside the MTL and decoded once", "[obj
   const texture_data& t = m.textures[0];
   CHECK(t.path == dir.path + "/mats/tex/a.png");
   REQUIRE(t.width == 2);
-  CHECK(t.rgb[0].x == Approx(0.2158605f).margin(1e-7));
-  CHECK(t.alpha[0] == 1.0f);
-  CHECK(t.alpha[1] == 0.0f);
+  CHECK(texel_rgb(t, 0).x == Approx(0.2158605f).margin(1e-7));
+  CHECK(texel_alpha(t, 0) == 1.0f);
+  CHECK(texel_alpha(t, 1) == 0.0f);
   CHECK(eval_texture_alpha(t, {0.9f, 0.5f}) == 0.0f);
 }
 

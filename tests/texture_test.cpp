@@ -80,12 +80,17 @@ TEST_CASE("an RGB PNG decodes to linear texels top row first", "[texture]") {
   REQUIRE(t.width == 1);
   REQUIRE(t.height == 2);
   CHECK(t.path == path);
-  CHECK(t.rgb[0].x == srgb8_to_linear(128));
-  CHECK(t.rgb[1].x == 1.0f);
-  CHECK(t.rgb[1].y == 0.0f);
+  CHECK(texel_rgb(t, 0).x == srgb8_to_linear(128));
+  CHECK(texel_rgb(t, 1).x == 1.0f);
+  CHECK(texel_rgb(t, 1).y == 0.0f);
   // Without an alpha channel the mask is the first channel, linear.
-  CHECK(t.alpha[0] == Approx(128.0f / 255.0f));
-  CHECK(t.alpha[1] == 1.0f);
+  CHECK(texel_alpha(t, 0) == Approx(128.0f / 255.0f));
+  CHECK(texel_alpha(t, 1) == 1.0f);
+  // Kept as the file's own bytes (3 per texel here), not as float RGB + alpha (16 per texel): a 4096² RGBA texture
+  // takes 64 MiB, not 256 MiB.
+  CHECK(t.channels == 3);
+  CHECK(t.texels8 == std::vector<uint8_t>{128, 128, 128, 255, 0, 0});
+  CHECK(t.texels16.empty());
 }
 
 TEST_CASE("v equal to zero is the bottom row of the image", "[texture]") {
@@ -145,13 +150,13 @@ TEST_CASE("alpha comes from the alpha channel when there is one and from grey ot
   texture_data grey = load_texture(write_png(dir, "g.png", 1, 1, 1, {51}));
   texture_data grey_alpha = load_texture(write_png(dir, "ga.png", 1, 1, 2, {51, 204}));
   texture_data rgba = load_texture(write_png(dir, "rgba.png", 1, 1, 4, {255, 0, 0, 102}));
-  CHECK(grey.alpha[0] == Approx(0.2f));
-  CHECK(grey.rgb[0].y == srgb8_to_linear(51));
-  CHECK(grey_alpha.alpha[0] == Approx(0.8f));
-  CHECK(grey_alpha.rgb[0].z == srgb8_to_linear(51));
-  CHECK(rgba.alpha[0] == Approx(0.4f));
-  CHECK(rgba.rgb[0].x == 1.0f);
-  CHECK(rgba.rgb[0].y == 0.0f);
+  CHECK(texel_alpha(grey, 0) == Approx(0.2f));
+  CHECK(texel_rgb(grey, 0).y == srgb8_to_linear(51));
+  CHECK(texel_alpha(grey_alpha, 0) == Approx(0.8f));
+  CHECK(texel_rgb(grey_alpha, 0).z == srgb8_to_linear(51));
+  CHECK(texel_alpha(rgba, 0) == Approx(0.4f));
+  CHECK(texel_rgb(rgba, 0).x == 1.0f);
+  CHECK(texel_rgb(rgba, 0).y == 0.0f);
 }
 
 TEST_CASE("16-bit images decode through the same sRGB curve", "[texture]") {
@@ -161,10 +166,12 @@ TEST_CASE("16-bit images decode through the same sRGB curve", "[texture]") {
   REQUIRE(t.width == 2);
   REQUIRE(t.height == 1);
   float c = 32896.0f / 65535.0f;
-  CHECK(t.rgb[0].x == Approx(std::pow((c + 0.055) / 1.055, 2.4)).epsilon(1e-6));
-  CHECK(t.rgb[1].x == 1.0f);
-  CHECK(t.alpha[0] == 1.0f);
-  CHECK(t.alpha[1] == 0.0f);
+  CHECK(texel_rgb(t, 0).x == Approx(std::pow((c + 0.055) / 1.055, 2.4)).epsilon(1e-6));
+  CHECK(texel_rgb(t, 1).x == 1.0f);
+  CHECK(texel_alpha(t, 0) == 1.0f);
+  CHECK(texel_alpha(t, 1) == 0.0f);
+  CHECK(t.texels8.empty());  // 16 bits per channel kept as such
+  CHECK(t.texels16.size() == size_t(2 * t.channels));
 }
 
 TEST_CASE("missing garbage truncated and unsupported images are input errors", "[texture]") {
@@ -207,7 +214,7 @@ TEST_CASE("truncated TGA and BMP files and impossible sizes are input errors", "
   write_bytes(dir.file("ok.tga"), tga);
   texture_data t = load_texture(dir.file("ok.tga"));
   REQUIRE(t.width == 2);
-  CHECK(t.rgb[0].x == srgb8_to_linear(0x30));
+  CHECK(texel_rgb(t, 0).x == srgb8_to_linear(0x30));
   write_bytes(dir.file("cut.tga"), tga.substr(0, 21));
   CHECK_THAT(texture_error(dir.file("cut.tga")), Catch::Contains("cut.tga: cannot decode image: truncated"));
   // A BMP written by stb, whole and cut short.
@@ -215,7 +222,7 @@ TEST_CASE("truncated TGA and BMP files and impossible sizes are input errors", "
   REQUIRE(stbi_write_bmp(dir.file("ok.bmp").c_str(), 8, 8, 3, px.data()) != 0);
   std::ifstream in(dir.file("ok.bmp"), std::ios::binary);
   std::string bmp((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  CHECK(load_texture(dir.file("ok.bmp")).rgb[63].y == srgb8_to_linear(77));
+  CHECK(texel_rgb(load_texture(dir.file("ok.bmp")), 63).y == srgb8_to_linear(77));
   write_bytes(dir.file("cut.bmp"), bmp.substr(0, bmp.size() - 10));
   CHECK_THAT(texture_error(dir.file("cut.bmp")), Catch::Contains("cut.bmp: cannot decode image: truncated"));
   // 22 bytes that claim 1537x65281 texels (found by fuzzing: 1.6 GB of decoded zeros).
