@@ -1,8 +1,9 @@
 // obj_validate: line-by-line checks of OBJ and MTL text, written to accept only what tinyobjloader parses
 // exactly as we read it (its number grammar, its index forms) and to name file and line on every rejection.
-// Invariants: lines end at \n, \r\n or a lone \r; a token starting with '#' starts a comment; tokens are split
-// at spaces, tabs, \v and \f; numbers are finite floats of at most max_number_chars characters and decimal
-// exponent at most 300 in magnitude; every index refers to an element defined earlier in the file.
+// Invariants: lines end at \n, \r\n or a lone \r (a statement ending in a backslash continues on the next); a
+// token starting with '#' starts a comment; tokens are split at spaces, tabs, \v and \f; numbers are finite
+// floats of at most max_number_chars characters and decimal exponent at most 300 in magnitude; every index refers
+// to an element defined earlier in the file.
 #include "obj_validate.h"
 
 #include "errors.h"
@@ -52,21 +53,48 @@ std::string read_text_file(const std::string& path, const char* what) {
   return read_file(path);
 }
 
-// Splits text into lines (\n, \r\n or lone \r), skipping a UTF-8 byte-order mark.
+// Splits text into lines (\n, \r\n or lone \r), skipping a UTF-8 byte-order mark. A statement line ending in a
+// backslash continues on the next line (the OBJ format's continuation; not a comment line, whose text may end in a
+// Windows path). `line` is the first line of the statement, for messages.
 struct line_reader {
   const std::string& text;
   size_t pos = 0;
-  size_t line = 0;
+  size_t line = 0;      // first physical line of the statement last returned
+  size_t physical = 0;  // physical lines read
+  std::string joined;   // a continued statement's text
   explicit line_reader(const std::string& t) : text(t) {
     if (text.compare(0, 3, "\xEF\xBB\xBF") == 0) pos = 3;
   }
-  bool next(string_view& out) {
+  bool next_physical(string_view& out) {
     if (pos >= text.size()) return false;
     size_t end = text.find_first_of("\r\n", pos);
     if (end == std::string::npos) end = text.size();
     out = string_view(text).substr(pos, end - pos);
     pos = end + ((end + 1 < text.size() && text[end] == '\r' && text[end + 1] == '\n') ? 2 : 1);
-    line++;
+    physical++;
+    return true;
+  }
+  // The line without trailing blanks ends in a backslash, and is not a comment.
+  static bool continues(string_view l) {
+    size_t e = l.find_last_not_of(" \t\v\f");
+    size_t b = l.find_first_not_of(" \t\v\f");
+    return e != string_view::npos && l[e] == '\\' && l[b] != '#';
+  }
+  bool next(string_view& out) {
+    if (!next_physical(out)) return false;
+    line = physical;
+    if (!continues(out)) return true;
+    joined.clear();
+    string_view more = out;
+    while (continues(more)) {
+      joined.append(more.substr(0, more.find_last_not_of(" \t\v\f"))) += ' ';
+      if (!next_physical(more)) {
+        more = {};
+        break;
+      }
+    }
+    joined.append(more);
+    out = joined;
     return true;
   }
 };

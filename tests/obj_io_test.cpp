@@ -305,6 +305,19 @@ TEST_CASE("odd but legal files from real tools load", "[obj]") {
   CHECK(m.materials[0].kd.x == 1.0f);
 }
 
+TEST_CASE("a statement ending in a backslash continues on the next line", "[obj]") {
+  // The OBJ format's line continuation; a comment ending in a backslash (a Windows path) does not swallow the next
+  // line; an error in a continued statement names its first line.
+  temp_dir dir;
+  auto obj = dir.write("c.obj", "v 0 0 0\nv 1 0 \\\n 0\nv 1 1 0\n# from C:\\scenes\\\nv 0 1 0\nf 1 \\\r\n2 \\  \n3 4\n");
+  mesh_data m = load_obj(obj);
+  check_invariants(m);
+  CHECK(m.positions.size() == 4);
+  CHECK(triangle_count(m) == 2);
+  auto bad = dir.write("d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 \\\n 2 \\\n 9\n");
+  CHECK_THAT(load_error(bad), Catch::Contains(bad + ":4: ") && Catch::Contains("9"));
+}
+
 TEST_CASE("the subdivided Cornell box layout loads", "[obj]") {
   // Statement shapes of a real exported scene: mtllib first, o/usemtl per object, quads.
   temp_dir dir;
