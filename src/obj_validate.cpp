@@ -496,7 +496,10 @@ obj_clean_data validate_obj(const std::string& path) {
 
   // Resolve the used names (first definition wins, as in tinyobjloader) in order of first use.
   std::map<std::string, int> defined_index;
-  for (size_t i = 0; i < st.defined.size(); i++) defined_index.emplace(st.defined[i].material.name, int(i));
+  for (size_t i = 0; i < st.defined.size(); i++)
+    if (!defined_index.emplace(st.defined[i].material.name, int(i)).second)
+      std::cerr << "warning: " << st.defined[i].mtl_path << ": material " << quote(st.defined[i].material.name)
+                << " is defined again; its first definition is used\n";
   for (size_t k = 0; k < st.used_names.size(); k++) {
     auto it = defined_index.find(st.used_names[k]);
     if (it != defined_index.end()) {

@@ -398,6 +398,12 @@ TEST_CASE("materials the renderer changes or ignores are named in a warning", "[
   REQUIRE(r.status == 0);
   CHECK(r.output.find("box.obj:12: usemtl of undefined material 'lamp': its faces get the default material") !=
         std::string::npos);
+  // A material defined twice: the first definition holds (as in tinyobjloader), and a warning says so.
+  write_text(s.dir / "box.mtl", "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\nnewmtl floor\nKd 1 0 0\n");
+  r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "o.pfm"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("box.mtl: material 'floor' is defined again; its first definition is used") != std::string::npos);
 }
 
 TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
