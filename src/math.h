@@ -50,6 +50,7 @@ inline float length(vec3f a) { return std::sqrt(dot(a, a)); }
 inline vec3f normalize(vec3f a) {
   float l = length(a);
   if (l > 1e-18f && l < 1e18f) return a / l;
+  if (std::isnan(l)) return {0, 0, 0};  // (std::max below would drop a NaN component)
   float m = std::max(std::fabs(a.x), std::max(std::fabs(a.y), std::fabs(a.z)));
   if (!(m > 0)) return {0, 0, 0};
   if (!(m < std::numeric_limits<float>::infinity())) return {0, 0, 0};  // an infinite component has no direction

@@ -74,11 +74,15 @@ struct line_reader {
     physical++;
     return true;
   }
-  // The line without trailing blanks ends in a backslash, and is not a comment.
+  // The line without trailing blanks ends in a backslash that is not inside a comment (a token starting with '#'
+  // starts one, as in tokenize: "f 1 2 3 # from C:\\scans\\" does not continue).
   static bool continues(string_view l) {
     size_t e = l.find_last_not_of(" \t\v\f");
-    size_t b = l.find_first_not_of(" \t\v\f");
-    return e != string_view::npos && l[e] == '\\' && l[b] != '#';
+    if (e == string_view::npos || l[e] != '\\') return false;
+    for (size_t i = 0; i < e; i++)
+      if (l[i] == '#' && (i == 0 || l[i - 1] == ' ' || l[i - 1] == '\t' || l[i - 1] == '\v' || l[i - 1] == '\f'))
+        return false;
+    return true;
   }
   bool next(string_view& out) {
     if (!next_physical(out)) return false;

@@ -226,9 +226,15 @@ scene_desc load_scene_desc(const std::string& path) {
     if (r.contains("spp")) desc.spp = int(get_integer(ctx, r["spp"], "spp", 1, std::numeric_limits<int>::max()));
     if (r.contains("max_depth")) desc.max_depth = int(get_integer(ctx, r["max_depth"], "max_depth", 1, 1000));
     if (r.contains("seed")) {
-      if (!r["seed"].is_number_unsigned())
-        ctx.fail("seed", "\"seed\" must be an integer from 0 to 18446744073709551615");
-      desc.seed = r["seed"].get<uint64_t>();
+      const json& s = r["seed"];
+      if (s.is_number_float() && s.get<double>() >= 0 && s.get<double>() <= 9007199254740992.0 &&
+          std::floor(s.get<double>()) == s.get<double>()) {
+        desc.seed = uint64_t(s.get<double>());  // a whole number written as 7.0 (as other integers)
+      } else {
+        if (!s.is_number_unsigned())
+          ctx.fail("seed", "\"seed\" must be an integer from 0 to 18446744073709551615");
+        desc.seed = s.get<uint64_t>();
+      }
     }
   }
   if (root.contains("sun")) parse_sun(ctx, root["sun"], desc.sun);

@@ -25,7 +25,8 @@ struct texture_data {
   int channels = 0;                   // 1 grey, 2 grey + alpha, 3 RGB, 4 RGBA
   std::vector<uint8_t> texels8;       // 8-bit images: width * height * channels values
   std::vector<uint16_t> texels16;     // 16-bit images (then texels8 is empty)
-  const float* to_linear = nullptr;   // the colour decode table of the bit depth (256 or 65536 entries)
+  const float* to_linear = nullptr;   // the colour decode table of the bit depth (256 or 65536 entries); set by
+                                      // load_texture and texture_from_texels8 (the only ways to make a texture)
 };
 
 // Linear RGB and alpha mask of texel i (row-major index); the texture must hold width * height texels.
@@ -45,10 +46,11 @@ inline float texel_alpha(const texture_data& t, size_t i) {
   if (!t.texels8.empty()) return float(t.texels8[a]) * (1.0f / 255.0f);
   return float(t.texels16[a]) * (1.0f / 65535.0f);
 }
-// Whether t holds all its texels (a default-constructed texture holds none).
+// Whether t holds all its texels at one bit depth (a default-constructed texture holds none).
 inline bool texture_complete(const texture_data& t) {
   size_t n = size_t(t.width) * size_t(t.height) * size_t(t.channels);
-  return t.width > 0 && t.height > 0 && t.to_linear && (t.texels8.size() == n || t.texels16.size() == n) && n > 0;
+  bool eight = t.texels8.size() == n && t.texels16.empty(), sixteen = t.texels16.size() == n && t.texels8.empty();
+  return t.width > 0 && t.height > 0 && t.channels >= 1 && t.channels <= 4 && t.to_linear && n > 0 && (eight || sixteen);
 }
 
 // Loads an image file (PNG, JPEG, TGA, BMP via stb_image); throws input_error naming the file on failure.

@@ -252,7 +252,7 @@ TEST_CASE("whole numbers written with a fraction or exponent are integers", "[cl
   // Many JSON writers emit 64.0 for an integer-valued number: the scene means 64.
   tiny_scene s;
   write_text(s.dir / "float.json", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], \"target\": [0, 0, 0]},"
-                                   " \"image\": {\"width\": 16.0, \"height\": 1.2e1}, \"render\": {\"spp\": 2.0, \"max_depth\": 2e0}}");
+                                   " \"image\": {\"width\": 16.0, \"height\": 1.2e1}, \"render\": {\"spp\": 2.0, \"max_depth\": 2e0, \"seed\": 0.0}}");
   auto a = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "int.pfm"));
   auto b = run_bayeslight("render " + (s.dir / "float.json") + " --quiet -o " + (s.dir / "float.pfm"));
   INFO(a.output << b.output);

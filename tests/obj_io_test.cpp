@@ -316,6 +316,11 @@ TEST_CASE("a statement ending in a backslash continues on the next line", "[obj]
   CHECK(triangle_count(m) == 2);
   auto bad = dir.write("d.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 \\\n 2 \\\n 9\n");
   CHECK_THAT(load_error(bad), Catch::Contains(bad + ":4: ") && Catch::Contains("9"));
+  // A trailing comment ending in a backslash ends its statement: the next line stays a statement of its own.
+  auto trailing = dir.write("e.obj", "v 0 0 0 # from C:\\scans\\\nv 1 0 0\nv 1 1 0\t#\\\nv 0 1 0\nf 1 2 3 4\n");
+  mesh_data t = load_obj(trailing);
+  CHECK(t.positions.size() == 4);
+  CHECK(triangle_count(t) == 2);
 }
 
 TEST_CASE("the subdivided Cornell box layout loads", "[obj]") {

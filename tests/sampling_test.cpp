@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include <functional>
+#include <limits>
 
 using namespace bl;
 using namespace bl::test;
@@ -57,6 +58,27 @@ double direction_pvalue(const std::function<vec3f(vec2f)>& warp, const std::func
 }
 
 }  // namespace
+
+TEST_CASE("normalize gives the unit vector at any finite scale and zero for zero, NaN or infinite input", "[sampling]") {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  vec3f unit = normalize(vec3f{3, 4, 12});  // 13 long
+  CHECK(unit.x == 3.0f / 13.0f);
+  for (float scale : {1e-30f, 1e-20f, 1e20f, 1e30f}) {
+    INFO("scale " << scale);
+    vec3f v = normalize(vec3f{3, 4, 12} * scale);  // squared length out of float's normal range
+    CHECK(v.x == Approx(3.0 / 13).epsilon(1e-6));
+    CHECK(v.z == Approx(12.0 / 13).epsilon(1e-6));
+    CHECK(length(v) == Approx(1.0).epsilon(1e-6));
+  }
+  for (vec3f bad : {vec3f{0, 0, 0}, vec3f{nan, 1, 0}, vec3f{1, nan, 0}, vec3f{1, 0, nan}, vec3f{inf, 1, 0},
+                    vec3f{1, -inf, 0}}) {
+    vec3f v = normalize(bad);
+    INFO(bad.x << " " << bad.y << " " << bad.z);
+    CHECK(v.x == 0);
+    CHECK(v.y == 0);
+    CHECK(v.z == 0);
+  }
+}
 
 TEST_CASE("cosine hemisphere samples follow cos over pi", "[sampling]") {
   double p = direction_pvalue([](vec2f u) { return sample_cosine_hemisphere(u.x, u.y); },
