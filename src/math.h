@@ -45,17 +45,22 @@ inline vec3f cross(vec3f a, vec3f b) {
 }
 inline float length_sq(vec3f a) { return dot(a, a); }
 inline float length(vec3f a) { return std::sqrt(dot(a, a)); }
-// Unit vector along a; a zero (or NaN) vector gives zero, never NaN. A vector so long or so short that its squared
-// length leaves float's normal range is first scaled by its largest component (the common case is a / |a|).
+// normalize's rare case, out of line (so that the common case inlines as small as it was): a vector so long or so
+// short that its squared length leaves float's normal range is scaled by its largest component first; zero, NaN
+// and infinite vectors give zero.
+[[gnu::noinline, gnu::cold]] inline vec3f normalize_wide(vec3f a) {
+  if (std::isnan(a.x) || std::isnan(a.y) || std::isnan(a.z)) return {0, 0, 0};
+  float m = std::max(std::fabs(a.x), std::max(std::fabs(a.y), std::fabs(a.z)));
+  if (!(m > 0) || !(m < std::numeric_limits<float>::infinity())) return {0, 0, 0};
+  a = a / m;
+  return a / length(a);
+}
+// Unit vector along a; a zero (or NaN) vector gives zero, never NaN; any finite non-zero length works (see
+// normalize_wide). The common case is a / |a|.
 inline vec3f normalize(vec3f a) {
   float l = length(a);
   if (l > 1e-18f && l < 1e18f) return a / l;
-  if (std::isnan(l)) return {0, 0, 0};  // (std::max below would drop a NaN component)
-  float m = std::max(std::fabs(a.x), std::max(std::fabs(a.y), std::fabs(a.z)));
-  if (!(m > 0)) return {0, 0, 0};
-  if (!(m < std::numeric_limits<float>::infinity())) return {0, 0, 0};  // an infinite component has no direction
-  a = a / m;
-  return a / length(a);
+  return normalize_wide(a);
 }
 inline vec3f vmin(vec3f a, vec3f b) { return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)}; }
 inline vec3f vmax(vec3f a, vec3f b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }
