@@ -347,6 +347,7 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       cur->material.name = join_from(t, 1);
       has_kd.push_back(0);
       cur->mtl_path = path;
+      cur->line = int(std::min<size_t>(lines.line, INT_MAX));
       continue;
     }
     bool texture =
@@ -502,8 +503,8 @@ obj_clean_data validate_obj(const std::string& path) {
   std::map<std::string, int> defined_index;
   for (size_t i = 0; i < st.defined.size(); i++)
     if (!defined_index.emplace(st.defined[i].material.name, int(i)).second)
-      std::cerr << "warning: " << st.defined[i].mtl_path << ": material " << quote(st.defined[i].material.name)
-                << " is defined again; its first definition is used\n";
+      std::cerr << "warning: " << st.defined[i].mtl_path << ":" << st.defined[i].line << ": material "
+                << quote(st.defined[i].material.name) << " is defined again; its first definition is used\n";
   for (size_t k = 0; k < st.used_names.size(); k++) {
     auto it = defined_index.find(st.used_names[k]);
     if (it != defined_index.end()) {

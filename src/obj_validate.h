@@ -19,6 +19,7 @@ struct mtl_material_data {
   std::string kd_map, alpha_map;  // map_Kd / map_d file names as written ("" when absent)
   int kd_map_line = 0, alpha_map_line = 0;
   std::string mtl_path;  // the MTL file that defined it (texture paths are relative to its folder)
+  int line = 0;          // its newmtl line there
 };
 
 // The validated OBJ: clean text for tinyobjloader and what the conversion needs beside it.

@@ -97,6 +97,14 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   cam.frame_target = has_eye && !has_target;
   if (has_eye) cam.eye = get_vec3(ctx, j["eye"], "eye");
   if (has_target) cam.target = get_vec3(ctx, j["target"], "target");
+  // Embree refuses ray origins beyond about 1.8e18 (a camera framed from a target-only key sits near its target);
+  // no mesh that keeps a triangle reaches 1e17 (float spacing there exceeds any triangle whose area is finite).
+  auto within_range = [&](bool given, vec3f v, const std::string& key) {
+    if (given && !(max_abs_component(v) <= 1e17f))
+      ctx.fail(key, "camera \"" + key + "\" must lie within 1e17 of the origin in every coordinate");
+  };
+  within_range(has_eye, cam.eye, "eye");
+  within_range(has_target, cam.target, "target");
   if (j.contains("up")) cam.up = get_vec3(ctx, j["up"], "up");
   if (j.contains("fov_y_deg")) cam.fov_y_deg = get_number(ctx, j["fov_y_deg"], "fov_y_deg");
   if (!(cam.fov_y_deg > 0 && cam.fov_y_deg < 179))
@@ -227,7 +235,7 @@ scene_desc load_scene_desc(const std::string& path) {
     if (r.contains("max_depth")) desc.max_depth = int(get_integer(ctx, r["max_depth"], "max_depth", 1, 1000));
     if (r.contains("seed")) {
       const json& s = r["seed"];
-      if (s.is_number_float() && s.get<double>() >= 0 && s.get<double>() <= 9007199254740992.0 &&
+      if (s.is_number_float() && s.get<double>() >= 0 && s.get<double>() < 18446744073709551616.0 &&
           std::floor(s.get<double>()) == s.get<double>()) {
         desc.seed = uint64_t(s.get<double>());  // a whole number written as 7.0 (as other integers)
       } else {

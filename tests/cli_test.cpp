@@ -167,6 +167,11 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
       {"seed_range.json", "{\"mesh\": \"box.obj\", \"render\": {\"seed\": -1}}", "seed_range.json:1: \"seed\""},
       {"fraction.json", "{\"mesh\": \"box.obj\", \"render\": {\"spp\": 2.5}}", "fraction.json:1: \"spp\" must be an integer"},
       {"nul.json", "{\"mesh\": \"box.obj\\u0000junk\"}", "nul.json:1: \"mesh\" must not contain a NUL"},
+      // Embree aborts on a ray origin beyond about 1.8e18; a target-only camera is framed near its target.
+      {"far_eye.json", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0, 1e19], \"target\": [0, 0, 0]}}",
+       "far_eye.json:1: camera \"eye\" must lie within 1e17"},
+      {"far_target.json", "{\"mesh\": \"box.obj\", \"camera\": {\"target\": [1e30, 0, 0]}}",
+       "far_target.json:1: camera \"target\" must lie within 1e17"},
   };
   write_text(s.dir / "bad.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n");
   for (const auto& c : cases) {
@@ -403,7 +408,7 @@ TEST_CASE("materials the renderer changes or ignores are named in a warning", "[
   r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "o.pfm"));
   INFO(r.output);
   REQUIRE(r.status == 0);
-  CHECK(r.output.find("box.mtl: material 'floor' is defined again; its first definition is used") != std::string::npos);
+  CHECK(r.output.find("box.mtl:6: material 'floor' is defined again; its first definition is used") != std::string::npos);
 }
 
 TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
