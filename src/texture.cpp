@@ -58,6 +58,12 @@ static long long le(const std::string& b, size_t off, int n) {
   for (int i = n - 1; i >= 0; i--) v = v * 256 + (off + size_t(i) < b.size() ? (unsigned char)b[off + size_t(i)] : 0);
   return v;
 }
+// The big-endian 32-bit value at off (PNG fields), 0 past the end.
+static long long be32(const std::string& b, size_t off) {
+  long long v = 0;
+  for (size_t i = 0; i < 4; i++) v = v * 256 + (off + i < b.size() ? (unsigned char)b[off + i] : 0);
+  return v;
+}
 
 // Smallest file that can hold the pixels of an uncompressed TGA or BMP of w x h texels (0 for other formats):
 // stb_image reads zeros past the end of these, so a truncated file would otherwise decode without error.
@@ -194,6 +200,13 @@ texture_data load_texture(const std::string& path) {
   auto data = reinterpret_cast<const stbi_uc*>(bytes.data());
   int len = int(bytes.size());
   int w = 0, h = 0, n = 0;
+  // A PNG's size, from its header: stb_image refuses one of more than 2^30 bytes decoded with "unknown image type"
+  // (its other decoders' verdict), which would hide the reason.
+  if (bytes.size() >= 24 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0 && bytes.compare(12, 4, "IHDR") == 0) {
+    long long pw = be32(bytes, 16), ph = be32(bytes, 20);
+    if (pw * ph > max_texture_texels)
+      throw input_error(path, "image too large (" + std::to_string(pw) + "x" + std::to_string(ph) + " texels)");
+  }
   if (!stbi_info_from_memory(data, len, &w, &h, &n)) throw input_error(path, "cannot decode image: " + stb_reason());
   // stb_image 2.27's BMP info reports a top-down BMP (negative height in the file) with its negative height;
   // its decoder uses the magnitude. INT_MIN has none (abs() would overflow in stb) and stays rejected below.

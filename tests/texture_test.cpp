@@ -229,6 +229,10 @@ TEST_CASE("truncated TGA and BMP files and impossible sizes are input errors", "
   write_bytes(dir.file("tiny.tga"),
               std::string("\x01\0\x02\0\0\0\0\xdb\0\x04\0\0\x01\x06\x01\xff\x18\x41\x78\x05\x06\x07", 22));
   CHECK_THAT(texture_error(dir.file("tiny.tga")), Catch::Contains("cannot fit in 22 bytes"));
+  // A PNG header of 20000x20000 texels: its size is the reason given (stb_image alone says "unknown image type").
+  std::string ihdr("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x4e\x20\0\0\x4e\x20\x08\x06\0\0\0\0\0\0\0", 33);
+  write_bytes(dir.file("huge.png"), ihdr + std::string(64, '\0'));
+  CHECK_THAT(texture_error(dir.file("huge.png")), Catch::Contains("huge.png: image too large (20000x20000 texels)"));
 }
 
 TEST_CASE("an empty texture looks up as black and opaque", "[texture]") {
