@@ -102,9 +102,13 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   render_params p;
   p.width = o.width > 0 ? o.width : desc.width;
   p.height = o.height > 0 ? o.height : desc.height;
-  if ((long long)p.width * p.height > max_pixels)
-    throw usage_error("image of " + std::to_string(p.width) + "x" + std::to_string(p.height) +
-                      " pixels is too large (at most 2^28 pixels)");
+  if ((long long)p.width * p.height > max_pixels) {
+    // Bad input when the scene file gave a side of it (its "image"), else a bad command line.
+    std::string why = "image of " + std::to_string(p.width) + "x" + std::to_string(p.height) +
+                      " pixels is too large (at most 2^28 pixels)";
+    if (o.width > 0 && o.height > 0) throw usage_error(why);
+    throw input_error(desc.path, why);
+  }
   p.spp = o.spp > 0 ? o.spp : desc.spp;
   p.time_budget = o.time;
   p.max_depth = o.max_depth > 0 ? o.max_depth : desc.max_depth;

@@ -148,9 +148,8 @@ std::string lower_extension(const std::string& path) {
 
 }  // namespace
 
-// Largest image side and pixel count a scene may ask for (the CLI applies the same limits).
+// Largest image side a scene may ask for (the CLI applies the same limit; the pixel count is checked in cli.cpp).
 constexpr int64_t max_image_side = 65536;
-constexpr int64_t max_image_pixels = int64_t(1) << 28;
 
 scene_desc load_scene_desc(const std::string& path) {
   scene_desc desc;
@@ -222,11 +221,9 @@ scene_desc load_scene_desc(const std::string& path) {
   if (root.contains("image")) {
     const json& im = root["image"];
     check_keys(ctx, im, "image", {"width", "height"});
+    // Each side at most 65536; the pixel count (at most 2^28) is checked once --width and --height have had their say.
     if (im.contains("width")) desc.width = int(get_integer(ctx, im["width"], "width", 1, max_image_side));
     if (im.contains("height")) desc.height = int(get_integer(ctx, im["height"], "height", 1, max_image_side));
-    if (int64_t(desc.width) * desc.height > max_image_pixels)
-      ctx.fail("image", "image of " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
-                            " pixels is too large (at most 2^28 pixels)");
   }
   if (root.contains("render")) {
     const json& r = root["render"];

@@ -172,6 +172,8 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
        "far_eye.json:1: camera \"eye\" must lie within 1e17"},
       {"far_target.json", "{\"mesh\": \"box.obj\", \"camera\": {\"target\": [1e30, 0, 0]}}",
        "far_target.json:1: camera \"target\" must lie within 1e17"},
+      {"huge_image.json", "{\"mesh\": \"box.obj\", \"image\": {\"width\": 65536, \"height\": 65536}}",
+       "huge_image.json: image of 65536x65536 pixels is too large"},
   };
   write_text(s.dir / "bad.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n");
   for (const auto& c : cases) {
@@ -251,6 +253,22 @@ TEST_CASE("directions of any finite length point the same way", "[cli]") {
   CHECK(render_with("long", "[3e19, 1e20, 2e19]", "[0, 1e20, 0]") == unit);
   CHECK(render_with("short", "[3e-26, 1e-25, 2e-26]", "[0, 1e-25, 0]") == unit);
   CHECK(render_with("other", "[-0.3, 1, 0.2]", "[0, 1, 0]") != unit);  // the sun matters in this scene
+}
+
+TEST_CASE("a scene's image size too large to render is no error once --width and --height replace it", "[cli]") {
+  tiny_scene s;
+  write_text(s.dir / "huge.json", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], \"target\": [0, 0, 0]},"
+                                  " \"image\": {\"width\": 65536, \"height\": 65536}, \"render\": {\"spp\": 2, \"max_depth\": 2}}");
+  auto r = run_bayeslight("render " + (s.dir / "huge.json") + " --width 16 --height 12 --quiet -o " + (s.dir / "h.pfm"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  auto a = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "a.pfm"));
+  REQUIRE(a.status == 0);
+  CHECK(read_image(s.dir / "h.pfm").pixels == read_image(s.dir / "a.pfm").pixels);
+  // Only one side replaced: the scene's other side still makes it too large (bad input, naming the scene file).
+  auto one = run_bayeslight("render " + (s.dir / "huge.json") + " --width 16384 --quiet -o " + (s.dir / "o.pfm"));
+  CHECK(one.status == 3);
+  CHECK(one.output.find("huge.json: image of 16384x65536 pixels is too large") != std::string::npos);
 }
 
 TEST_CASE("whole numbers written with a fraction or exponent are integers", "[cli]") {
