@@ -118,11 +118,13 @@ static void tokenize(string_view line, const text_pos& pos, std::vector<string_v
   }
 }
 
-// Tokens [first, end) joined by single spaces (names and file names that contain spaces).
+// The text of tokens [first, end) as written, blanks between them included (names and file names that contain
+// spaces: "my  tex.png" keeps both); tokens are views into one line, so this is one span of it.
 static std::string join_from(const std::vector<string_view>& t, size_t first) {
-  std::string s;
-  for (size_t i = first; i < t.size(); i++) (s += (i > first ? " " : "")) += t[i];
-  return s;
+  if (first >= t.size()) return {};
+  const char* b = t[first].data();
+  const char* e = t.back().data() + t.back().size();
+  return std::string(b, size_t(e - b));
 }
 
 // True when t follows tinyobjloader's number grammar in full: [sign] (digits [. digits] | . digits)

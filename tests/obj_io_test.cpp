@@ -275,6 +275,14 @@ TEST_CASE("library and texture names may be quoted or use Windows separators", "
     CHECK(m.materials[0].kd_texture == 0);
     CHECK(m.materials[0].alpha_texture == 0);
   }
+  // Blanks inside a name are kept as written (two spaces are not one).
+  write_png(dir, "my mats/tex/two  spaces.png");
+  dir.write("my mats/two.mtl", "newmtl leaf\nmap_Kd tex/two  spaces.png\n");
+  auto obj = dir.write("t.obj", "mtllib my mats/two.mtl\n" + std::string(square_vertices) +
+                                    "vt 0.25 0.5\nusemtl leaf\nf 1/1 2/1 3/1\n");
+  mesh_data m = load_obj(obj);
+  REQUIRE(m.textures.size() == 1);
+  CHECK(m.textures[0].path == dir.path + "/my mats/tex/two  spaces.png");
 }
 
 TEST_CASE("degenerate triangles are dropped and counted", "[obj]") {
