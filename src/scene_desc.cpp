@@ -62,14 +62,21 @@ float get_number(const desc_context& ctx, const json& v, const std::string& key)
   return float(d);
 }
 
+// Whether v is a float-written whole number (64.0, 1e3: what many JSON writers emit for an integer) of magnitude
+// below `limit`; its value in out.
+bool whole_float(const json& v, double limit, double& out) {
+  if (!v.is_number_float()) return false;
+  out = v.get<double>();
+  return std::floor(out) == out && std::fabs(out) < limit;
+}
+
 // An integer in [lo, hi].
 int64_t get_integer(const desc_context& ctx, const json& v, const std::string& key, int64_t lo, int64_t hi) {
   int64_t i;
+  double d;
   if (v.is_number_float()) {
-    // A whole number written with a fraction or exponent (64.0, 1e3: what many JSON writers emit) is that integer.
-    double d = v.get<double>();
-    if (!(std::floor(d) == d)) ctx.fail(key, "\"" + key + "\" must be an integer");
-    if (!(std::fabs(d) <= 9007199254740992.0)) ctx.fail(key, "\"" + key + "\" is out of range");
+    if (!(std::floor(v.get<double>()) == v.get<double>())) ctx.fail(key, "\"" + key + "\" must be an integer");
+    if (!whole_float(v, 9007199254740994.0, d)  // up to 2^53) ctx.fail(key, "\"" + key + "\" is out of range");
     i = int64_t(d);
   } else {
     if (!v.is_number_integer()) ctx.fail(key, "\"" + key + "\" must be an integer");
@@ -232,9 +239,9 @@ scene_desc load_scene_desc(const std::string& path) {
     if (r.contains("max_depth")) desc.max_depth = int(get_integer(ctx, r["max_depth"], "max_depth", 1, 1000));
     if (r.contains("seed")) {
       const json& s = r["seed"];
-      if (s.is_number_float() && s.get<double>() >= 0 && s.get<double>() < 18446744073709551616.0 &&
-          std::floor(s.get<double>()) == s.get<double>()) {
-        desc.seed = uint64_t(s.get<double>());  // a whole number written as 7.0 (as other integers)
+      double d;
+      if (whole_float(s, 18446744073709551616.0, d) && d >= 0) {
+        desc.seed = uint64_t(d);  // a whole number written as 7.0 (as other integers)
       } else {
         if (!s.is_number_unsigned())
           ctx.fail("seed", "\"seed\" must be an integer from 0 to 18446744073709551615");

@@ -30,16 +30,14 @@ struct texture_data {
 };
 
 // Linear RGB and alpha mask of texel i (row-major index); the texture must hold width * height texels.
-inline vec3f texel_rgb(const texture_data& t, size_t i) {
-  size_t c = i * size_t(t.channels);
-  if (!t.texels8.empty()) {
-    const uint8_t* p = t.texels8.data() + c;
-    return t.channels >= 3 ? vec3f{t.to_linear[p[0]], t.to_linear[p[1]], t.to_linear[p[2]]}
-                           : vec3f{t.to_linear[p[0]], t.to_linear[p[0]], t.to_linear[p[0]]};
-  }
-  const uint16_t* p = t.texels16.data() + c;
+template <class T>  // uint8_t or uint16_t
+inline vec3f decode_texel(const texture_data& t, const T* p) {
   return t.channels >= 3 ? vec3f{t.to_linear[p[0]], t.to_linear[p[1]], t.to_linear[p[2]]}
                          : vec3f{t.to_linear[p[0]], t.to_linear[p[0]], t.to_linear[p[0]]};
+}
+inline vec3f texel_rgb(const texture_data& t, size_t i) {
+  size_t c = i * size_t(t.channels);
+  return t.texels8.empty() ? decode_texel(t, t.texels16.data() + c) : decode_texel(t, t.texels8.data() + c);
 }
 inline float texel_alpha(const texture_data& t, size_t i) {
   size_t a = i * size_t(t.channels) + size_t(t.channels == 2 || t.channels == 4 ? t.channels - 1 : 0);
