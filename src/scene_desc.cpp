@@ -76,7 +76,7 @@ int64_t get_integer(const desc_context& ctx, const json& v, const std::string& k
   double d;
   if (v.is_number_float()) {
     if (!(std::floor(v.get<double>()) == v.get<double>())) ctx.fail(key, "\"" + key + "\" must be an integer");
-    if (!whole_float(v, 9007199254740994.0, d)  // up to 2^53) ctx.fail(key, "\"" + key + "\" is out of range");
+    if (!whole_float(v, 9007199254740994.0, d)) ctx.fail(key, "\"" + key + "\" is out of range");  // up to 2^53
     i = int64_t(d);
   } else {
     if (!v.is_number_integer()) ctx.fail(key, "\"" + key + "\" must be an integer");
