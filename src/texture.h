@@ -48,7 +48,8 @@ inline float texel_alpha(const texture_data& t, size_t i) {
 inline bool texture_complete(const texture_data& t) {
   size_t n = size_t(t.width) * size_t(t.height) * size_t(t.channels);
   bool eight = t.texels8.size() == n && t.texels16.empty(), sixteen = t.texels16.size() == n && t.texels8.empty();
-  return t.width > 0 && t.height > 0 && t.channels >= 1 && t.channels <= 4 && t.to_linear && n > 0 && (eight || sixteen);
+  return t.width > 0 && t.height > 0 && t.channels >= 1 && t.channels <= 4 && t.to_linear && n > 0 &&
+         (eight || sixteen);
 }
 
 // Loads an image file (PNG, JPEG, TGA, BMP via stb_image); throws input_error naming the file on failure.
