@@ -505,7 +505,7 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
 
 void bayes_sampler::begin_frame(double decay) {
   if (decay >= 1) return;
-  decay_stats(stats, decay, params);
+  decay_stats(stats, decay);
   refresh_weights(stats, &regions.pair_parent, params);
   refresh_groups(nullptr);
 }
@@ -558,12 +558,10 @@ void bayes_sampler::add_pairs(int first_region) {
 
 void bayes_sampler::rebuild_posterior() {
   size_t n = stats.m.size();
-  stats.coeffs.resize(n);
   stats.weight.resize(params.region_prior ? 0 : n);
   stats.mu0.assign(n, 0.0f);
   stats.w.assign(n + 4, 0.0f);
   add_pairs(0);
-  for (size_t i = 0; i < n; i++) update_coeffs(stats, i, params);
   refresh_weights(stats, &regions.pair_parent, params);
   refresh_groups(nullptr);
 }
@@ -575,7 +573,7 @@ void bayes_sampler::learn(std::vector<row_state>& rows) {
   auto secs = [](clock::time_point a, clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
   size_t old_pairs = stats.m.size();
   auto t0 = clock::now();
-  std::vector<int> touched = merge_rows(stats, rows, params, parents);
+  std::vector<int> touched = merge_rows(stats, rows, parents);
   auto t1 = clock::now();
   int before = int(regions.key.size());
   std::vector<const region_requests*> r;
@@ -625,7 +623,7 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
       fold(k);
       if (!hier || first_child[k] == invalid_id) continue;  // no children (a fine pair, or none created yet)
       uint8_t flags = 0;
-      float now = stats.coeffs[k].p1;
+      float now = own_p1(stats, k, params);
       if (moved_by(now, stats.p1_folded[k])) {
         stats.p1_folded[k] = now;
         flags |= p1_moved;
@@ -642,7 +640,7 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
     for (size_t i = g.begin(); i < g.end(); i++) {
       fold(i);
       if (regions.pair_parent[i] == invalid_id) {
-        stats.p1_folded[i] = stats.coeffs[i].p1;
+        stats.p1_folded[i] = own_p1(stats, i, params);
         stats.k_folded[i] = float(own_posterior_mean(stats, i, params));
       }
     }

@@ -15,7 +15,6 @@ namespace bl {
 void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   size_t old = s.m.size(), n = size_t(pairs);
   s.m.resize(n);
-  s.coeffs.resize(n);
   s.weight.resize(p.region_prior ? 0 : n);
   s.mu0.resize(n, 0.0f);
   s.w.resize(n + 4, 0.0f);
@@ -23,31 +22,27 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   s.cv.resize(n + 4, 0.0f);
   if (n > old) {
     // All empty pairs share the prior-only coefficients (and, without data anywhere, the same weight).
-    update_coeffs(s, old, p);
     fold_weight(s, old, invalid_id, p);
     for (size_t i = old + 1; i < n; i++) {
-      s.coeffs[i] = s.coeffs[old];
       if (!p.region_prior) s.weight[i] = s.weight[old];
       s.w[i] = s.w[old];
       s.w_cv[i] = s.w_cv[old];
       s.cv[i] = s.cv[old];
     }
   }
-  s.p1_folded.resize(n, s.coeffs.empty() ? 1.0f : s.coeffs[n - 1].p1);
+  s.p1_folded.resize(n, n == 0 ? 1.0f : own_p1(s, n - 1, p));
   s.k_folded.resize(n, 0.0f);  // a parentless pair's is set by bayes_sampler::refold and refresh_weights
 }
 
-void decay_stats(bayes_stats& s, double gamma, const bayes_params& p) {
+void decay_stats(bayes_stats& s, double gamma) {
   for (size_t i = 0; i < s.m.size(); i++) {
     s.m[i].n0 *= gamma;
     s.m[i].n1 *= gamma;
     s.m[i].m2 *= gamma;  // the mean is unchanged by scaling all weights
-    update_coeffs(s, i, p);
   }
 }
 
-void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
-  const pair_moments& m = s.m[i];
+pair_coeffs pair_coefficients(const pair_moments& m, const bayes_params& p) {
   double n0 = m.n0, n1 = m.n1, z = m.mean, m2 = m.m2;
   double n = n0 + n1;
   double q2, q1 = 0, q0 = 0, qc = 0, p1;
@@ -79,7 +74,7 @@ void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p) {
       qc = c;
     }
   }
-  s.coeffs[i] = {float(q2), float(q1), float(q0), float(qc), float(p1)};
+  return {float(q2), float(q1), float(q0), float(qc), float(p1)};
 }
 
 bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, double mu0, double& k, double& h) {
@@ -152,7 +147,7 @@ void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const baye
       int up = parents ? (*parents)[i] : invalid_id;
       fold_weight(s, i, up, p);
       if (up < 0) {
-        s.p1_folded[i] = s.coeffs[i].p1;
+        s.p1_folded[i] = own_p1(s, i, p);
         s.k_folded[i] = float(own_posterior_mean(s, i, p));
       }
     }
@@ -171,8 +166,7 @@ static void merge_accum(pair_moments& m, const pair_accum& a) {
   }
 }
 
-std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const bayes_params& p,
-                            const std::vector<int>* parents) {
+std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const std::vector<int>* parents) {
   // Each accumulator updates its pair and that pair's parent. The updates of one pair must happen in row order (the
   // order fixes the floating-point result). Buckets (disjoint pair ranges) fold in parallel, each taking its updates
   // row by row in order: bit for bit the sequential fold for any number of buckets, so the count may follow the
@@ -217,17 +211,14 @@ std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const 
         uint8_t& seen = mb.seen[size_t(pair)];
         if (!seen) seen = 1, touched.push_back(pair);
       }
-    // Coefficients of the touched pairs (each depends on its own statistics only), in pair order for locality
-    // (this and the weight refold that follows): where most of the bucket was touched, by a scan of its flags.
+    // The touched pairs in pair order for the locality of the weight refold that follows, where most of the bucket
+    // was touched (by a scan of its flags).
     if (touched.size() * 16 > span) {
       touched.clear();
       for (size_t i = lo, e = std::min(n, size_t(lo) + span); i < e; i++)
         if (mb.seen[i]) touched.push_back(int(i));
     }
-    for (int i : touched) {
-      update_coeffs(s, size_t(i), p);
-      mb.seen[size_t(i)] = 0;
-    }
+    for (int i : touched) mb.seen[size_t(i)] = 0;
   });
   std::vector<int> out;
   size_t total = 0;

@@ -101,8 +101,8 @@ struct merge_buffers {
 };
 
 struct bayes_stats {
-  std::vector<pair_moments> m;           // statistics: read and written between passes only
-  std::vector<pair_coeffs> coeffs;       // posterior per pair without the hierarchy (between passes only)
+  std::vector<pair_moments> m;           // statistics: read and written between passes only (the posterior's
+                                         // coefficients are computed from them when a weight is folded: not kept)
   std::vector<pair_weight> weight;       // point-prior mode: read by every shading point (empty in region-prior mode,
                                          // whose points read `w`, a function of these and mu0)
   std::vector<float> mu0;                // region-prior mode: the pair's prior mean of z (set with its region)
@@ -125,17 +125,25 @@ struct bayes_stats {
 // naive ablation has no data (then there is no learned mean).
 bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, double mu0, double& k, double& h);
 
-// Grows the columns to `pairs` entries (new pairs start empty, with prior-only coefficients and weights).
+// Grows the columns to `pairs` entries (new pairs start empty, with prior-only weights).
 void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p);
-// Recomputes the coefficients of pair i from its statistics.
-void update_coeffs(bayes_stats& s, size_t i, const bayes_params& p);
-// Scales all statistics by gamma (animation: the prior regains weight); coefficients are refreshed.
-void decay_stats(bayes_stats& s, double gamma, const bayes_params& p);
+// The coefficients of a pair's posterior (without the hierarchy) from its statistics, rounded to float.
+pair_coeffs pair_coefficients(const pair_moments& m, const bayes_params& p);
+// Scales all statistics by gamma (animation: the prior regains weight); weights are refolded by the caller.
+void decay_stats(bayes_stats& s, double gamma);
 
+// E[1 - p0] of pair i under Beta(a0, b0) (plug-in n1 / n for the naive ablation), rounded to float: pair_coefficients'
+// p1, without the rest.
+inline float own_p1(const bayes_stats& s, size_t i, const bayes_params& p) {
+  const pair_moments& m = s.m[i];
+  double n = m.n0 + m.n1;
+  if (!p.prior) return n == 0 ? 1.0f : float(m.n1 / n);
+  return float((p.b0 + m.n1) / (p.a0 + p.b0 + n));
+}
 // E[1 - p0] of pair i, under the hierarchical prior when `up` (its parent pair) is valid.
 inline double pair_p1(const bayes_stats& s, size_t i, int up, const bayes_params& p) {
-  if (up < 0 || !(p.hierarchy > 0) || !p.prior) return s.coeffs[i].p1;
-  return (p.hierarchy * double(s.coeffs[size_t(up)].p1) + s.m[i].n1) / (p.hierarchy + s.m[i].n0 + s.m[i].n1);
+  if (up < 0 || !(p.hierarchy > 0) || !p.prior) return own_p1(s, i, p);
+  return (p.hierarchy * double(own_p1(s, size_t(up), p)) + s.m[i].n1) / (p.hierarchy + s.m[i].n0 + s.m[i].n1);
 }
 // Posterior mean of z of pair i under its own prior mean mu0 (what its fine children may start from).
 inline double own_posterior_mean(const bayes_stats& s, size_t i, const bayes_params& p) {
@@ -155,8 +163,8 @@ inline double prior_mean(const bayes_stats& s, size_t i, int up, const bayes_par
   return std::min(mu0, own_posterior_mean(s, size_t(up), p));
 }
 // Pair i's coefficients with p1 folded in: what a shading point evaluates in point-prior mode.
-inline pair_weight folded_coeffs(const bayes_stats& s, size_t i, double p1) {
-  const pair_coeffs& c = s.coeffs[i];
+inline pair_weight folded_coeffs(const bayes_stats& s, size_t i, double p1, const bayes_params& p) {
+  const pair_coeffs c = pair_coefficients(s.m[i], p);
   return {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
 }
 // Folds pair i's p1 (and, under the mean hierarchy, its parent's mean) into its sampling weight.
@@ -164,7 +172,7 @@ inline double eval_weight(const pair_weight& h, const bayes_params& p, double v,
 inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
   double p1 = pair_p1(s, i, up, p);
   if (up >= 0) s.p1_folded[i] = float(p1);  // a child: the p1 its weight now holds (see bayes_sampler::refold)
-  pair_weight pw = folded_coeffs(s, i, p1);
+  pair_weight pw = folded_coeffs(s, i, p1, p);
   if (!p.region_prior) {
     s.weight[i] = pw;  // read by every shading point in point-prior mode
     return;
@@ -185,9 +193,10 @@ inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p)
   s.w_cv[i] = float(std::sqrt(p1 * h + p1 * (1 - p1) * k * k));
   s.cv[i] = float(p1 * k);
 }
-// Whether what sampling reads of pair i (its coefficients, and its weight columns where the mode keeps them) is finite.
+// Whether pair i's statistics and what sampling reads of it (its weight columns where the mode keeps them) are finite.
 inline bool pair_state_finite(const bayes_stats& s, size_t i) {
-  bool ok = std::isfinite(s.coeffs[i].p1);
+  const pair_moments& m = s.m[i];
+  bool ok = std::isfinite(m.n0) && std::isfinite(m.n1) && std::isfinite(m.mean) && std::isfinite(m.m2);
   if (i < s.weight.size()) {
     const pair_weight& x = s.weight[i];
     ok = ok && std::isfinite(x.w2) && std::isfinite(x.w1) && std::isfinite(x.w0) && std::isfinite(x.wc);
@@ -237,11 +246,10 @@ struct bayes_row {
 };
 
 // Folds the rows, in order, into the statistics (Chan's parallel update) — each accumulator into its pair and
-// into that pair's parent (`parents` = region_state::pair_parent, or nullptr for none) — and refreshes the
-// coefficients of the pairs touched. Weights are not refolded (see fold_weight). Returns the touched pairs (each
+// into that pair's parent (`parents` = region_state::pair_parent, or nullptr for none). Weights are not refolded
+// (see fold_weight). Returns the touched pairs (each
 // once, in an order fixed by the rows). Work and memory scale with the rows' accumulators, not with the pairs.
-std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const bayes_params& p,
-                            const std::vector<int>* parents);
+std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const std::vector<int>* parents);
 
 // Reference form of the weight (the conjugate posterior written out, in double): sqrt((1 - p0)(k^2 + h)) / d^2
 // (or the ablations) from a pair's statistics and mu0 = scale * bound * d^2. eval_weight must agree with it.

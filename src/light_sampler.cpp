@@ -143,7 +143,7 @@ size_t sampler_memory_bytes(const light_sampler& s) {
   if (auto* b = std::get_if<bayes_sampler>(&s)) {
     // Every column the sampler keeps per pair (and the fallback check's per pixel), as allocated.
     const bayes_stats& st = b->stats;
-    return region_memory_bytes(b->regions) + bytes_of(st.m) + bytes_of(st.coeffs) + bytes_of(st.weight) +
+    return region_memory_bytes(b->regions) + bytes_of(st.m) + bytes_of(st.weight) +
            bytes_of(st.mu0) + bytes_of(st.w) + bytes_of(st.w_cv) + bytes_of(st.cv) + bytes_of(st.p1_folded) +
            bytes_of(st.k_folded) + bytes_of(st.gw) + bytes_of(st.gw_cv) + bytes_of(st.gcv) + bytes_of(st.gcol) +
            bytes_of(st.gtot) + bytes_of(st.gtot_cv) + bytes_of(b->first_child) +

@@ -24,8 +24,8 @@ namespace {
 
 // A parentless pair's coefficients with its p1 folded in: what a point-prior shading point evaluates (region-prior
 // mode, the default, folds them further into `w` and keeps no such column).
-pair_weight weight_of(const bayes_stats& s, size_t i) {
-  return folded_coeffs(s, i, s.coeffs[i].p1);
+pair_weight weight_of(const bayes_stats& s, size_t i, const bayes_params& p) {
+  return folded_coeffs(s, i, own_p1(s, i, p), p);
 }
 
 double unif(pcg32& r) {
@@ -345,7 +345,7 @@ TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes
         rows[size_t(rng(3))].add(i, z);
       }
     }
-    merge_rows(s, rows, p, nullptr);
+    merge_rows(s, rows, nullptr);
     refresh_weights(s, nullptr, p);
     int worst_pair = -1;
     double worst = 0;
@@ -353,7 +353,7 @@ TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes
       for (int k = 0; k < 20; k++) {
         double bound = log_uniform(rng, 1e-8, 1e8), scale = log_uniform(rng, 0.01, 1), d = log_uniform(rng, 1e-3, 1e3);
         double v = scale * bound, g = 1 / (d * d);
-        double fast = eval_weight(weight_of(s, size_t(i)), p, v, g);
+        double fast = eval_weight(weight_of(s, size_t(i), p), p, v, g);
         double ref =
             posterior_weight(p, bound, scale, d, s.m[size_t(i)].n0, s.m[size_t(i)].n1, s.m[size_t(i)].mean, s.m[size_t(i)].m2);
         double e = ref == 0 ? std::fabs(fast) : rel_err(fast, ref);
@@ -371,15 +371,15 @@ TEST_CASE("prior only weights are proportional to the bound", "[bayes]") {
     bayes_stats s;
     resize_stats(s, 5, p);
     pcg32 rng(41, 3);
-    double ratio = eval_weight(weight_of(s, 0), p, 1.0, 1.0);
+    double ratio = eval_weight(weight_of(s, 0, p), p, 1.0, 1.0);
     CHECK(ratio > 0);
     for (int k = 0; k < 200; k++) {
       double v = log_uniform(rng, 1e-10, 1e10), g = log_uniform(rng, 1e-6, 1e6);
-      CHECK(rel_err(eval_weight(weight_of(s, size_t(k % 5)), p, v, g), ratio * v) < 1e-12);
+      CHECK(rel_err(eval_weight(weight_of(s, size_t(k % 5), p), p, v, g), ratio * v) < 1e-12);
       double d = 1 / std::sqrt(g);
       CHECK(rel_err(posterior_weight(p, v, 1.0, d, 0, 0, 0, 0), ratio * v) < 1e-6);  // float coefficient
     }
-    CHECK(eval_weight(weight_of(s, 0), p, 0.0, 1.0) == 0);
+    CHECK(eval_weight(weight_of(s, 0, p), p, 0.0, 1.0) == 0);
   }
 }
 
@@ -527,12 +527,12 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
     if (grouping == 0) {
       std::vector<bayes_row> rows(1);
       for (auto [i, z] : stream) rows[0].add(i, z);
-      merge_rows(s, rows, p, nullptr);
+      merge_rows(s, rows, nullptr);
       refresh_weights(s, nullptr, p);
     } else if (grouping == 1) {
       std::vector<bayes_row> rows(stream.size());
       for (size_t k = 0; k < stream.size(); k++) rows[k].add(stream[k].first, stream[k].second);
-      merge_rows(s, rows, p, nullptr);
+      merge_rows(s, rows, nullptr);
       refresh_weights(s, nullptr, p);
     } else {
       size_t k = 0;
@@ -546,7 +546,7 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
           copy.clear();
           CHECK(copy.acc.empty());
         }
-        merge_rows(s, rows, p, nullptr);
+        merge_rows(s, rows, nullptr);
         refresh_weights(s, nullptr, p);
       }
     }
@@ -562,7 +562,7 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
       // The coefficients were refreshed from the merged statistics.
       double ref =
           posterior_weight(p, 2.0, 0.3, 1.5, s.m[size_t(i)].n0, s.m[size_t(i)].n1, s.m[size_t(i)].mean, s.m[size_t(i)].m2);
-      CHECK(rel_err(eval_weight(weight_of(s, size_t(i)), p, 0.6, 1 / 2.25), ref) < 1e-5);
+      CHECK(rel_err(eval_weight(weight_of(s, size_t(i), p), p, 0.6, 1 / 2.25), ref) < 1e-5);
     }
   }
 }
@@ -573,16 +573,16 @@ TEST_CASE("decaying statistics scales the counts and keeps the mean", "[bayes]")
   resize_stats(s, 2, p);
   std::vector<bayes_row> rows(1);
   for (double z : {0.0, 1.0, 2.0, 0.0, 4.0}) rows[0].add(1, z);
-  merge_rows(s, rows, p, nullptr);
+  merge_rows(s, rows, nullptr);
   refresh_weights(s, nullptr, p);
   double mean = s.m[1].mean, m2 = s.m[1].m2;
-  decay_stats(s, 0.5, p);
+  decay_stats(s, 0.5);
   refresh_weights(s, nullptr, p);
   CHECK(s.m[1].n0 == 1.0);
   CHECK(s.m[1].n1 == 1.5);
   CHECK(s.m[1].mean == mean);
   CHECK(s.m[1].m2 == 0.5 * m2);
-  CHECK(rel_err(eval_weight(weight_of(s, 1), p, 0.2, 0.5),
+  CHECK(rel_err(eval_weight(weight_of(s, 1, p), p, 0.2, 0.5),
                 posterior_weight(p, 0.2, 1.0, std::sqrt(2.0), 1.0, 1.5, mean, 0.5 * m2)) < 1e-5);
 }
 
@@ -833,7 +833,7 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     // More observations of cluster 0 reach only the parent: its posterior now differs from the fine pair's.
     std::vector<bayes_row> more(1);
     for (int k = 0; k < 6; k++) more[0].add(s.regions.pair_offset[size_t(coarse)], 3.0 + k);
-    merge_rows(s.stats, more, s.params, nullptr);
+    merge_rows(s.stats, more, nullptr);
     refresh_weights(s.stats, &s.regions.pair_parent, s.params);
     s.prepare(*ctx, pt);
     double w[3], own[3], sw = 0, sown = 0;
@@ -904,7 +904,7 @@ TEST_CASE("under the mean hierarchy a fine pair's prior mean is the lower of its
     std::vector<bayes_row> more(1);
     double low = 0.01 * s.stats.mu0[base];
     for (int k = 0; k < 40; k++) more[0].add(int(cbase), low * (1 + 0.01 * k));
-    merge_rows(s.stats, more, s.params, nullptr);
+    merge_rows(s.stats, more, nullptr);
     refresh_weights(s.stats, &s.regions.pair_parent, s.params);
     const pair_moments& mp = s.stats.m[cbase];
     REQUIRE(mp.n1 == 42);
@@ -912,7 +912,7 @@ TEST_CASE("under the mean hierarchy a fine pair's prior mean is the lower of its
     REQUIRE(k_parent < 0.1 * s.stats.mu0[base]);
     double expect = means ? std::min(double(s.stats.mu0[base]), k_parent) : double(s.stats.mu0[base]);
     CHECK(prior_mean(s.stats, base, int(cbase), s.params) == Approx(expect).epsilon(1e-12));
-    pair_weight pw = folded_coeffs(s.stats, base, pair_p1(s.stats, base, int(cbase), s.params));
+    pair_weight pw = folded_coeffs(s.stats, base, pair_p1(s.stats, base, int(cbase), s.params), s.params);
     double w_expect = eval_weight(pw, s.params, expect, 1.0);
     double w_bound = eval_weight(pw, s.params, s.stats.mu0[base], 1.0);
     CHECK(s.stats.w[base] == Approx(w_expect).epsilon(1e-6));
