@@ -514,16 +514,15 @@ void bayes_sampler::add_pairs(int first_region) {
   resize_stats(stats, regions.pairs, params);
   // Children lists of the coarse pairs (refold reaches a coarse pair's children through them).
   size_t npairs = stats.m.size();
-  if (first_region == 0) first_child.clear(), next_sibling.clear();
-  first_child.resize(npairs, invalid_id);
-  next_sibling.resize(npairs, invalid_id);
+  if (first_region == 0) child_link.clear();
+  child_link.resize(npairs, invalid_id);
   for (size_t r = size_t(first_region); r < regions.key.size(); r++) {
     size_t b = size_t(regions.pair_offset[r]), e = b + size_t(regions.pair_count[r]);
     for (size_t k = b; k < e; k++) {
       int up = regions.pair_parent[k];
       if (up == invalid_id) continue;
-      next_sibling[k] = first_child[size_t(up)];
-      first_child[size_t(up)] = int(k);
+      child_link[k] = child_link[size_t(up)];
+      child_link[size_t(up)] = int(k);
     }
   }
   if (!params.region_prior) return;
@@ -621,7 +620,8 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
     for (size_t t = g.begin(); t < g.end(); t++) {
       size_t k = size_t(touched[t]);
       fold(k);
-      if (!hier || first_child[k] == invalid_id) continue;  // no children (a fine pair, or none created yet)
+      // No children: a fine pair (its link is a sibling), or a coarse one whose fine regions do not exist yet.
+      if (!hier || regions.pair_parent[k] != invalid_id || child_link[k] == invalid_id) continue;
       uint8_t flags = 0;
       float now = own_p1(stats, k, params);
       if (moved_by(now, stats.p1_folded[k])) {
@@ -661,7 +661,7 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
           low = std::min(now, stats.k_folded[size_t(k)]);
           stats.k_folded[size_t(k)] = now;
         }
-        for (int c = first_child[size_t(k)]; c != invalid_id; c = next_sibling[size_t(c)])
+        for (int c = child_link[size_t(k)]; c != invalid_id; c = child_link[size_t(c)])
           if (((flags & mean_moved) && stats.mu0[size_t(c)] > low) ||
               ((flags & p1_moved) && moved_by(pair_p1(stats, size_t(c), k, params), stats.p1_folded[size_t(c)]))) {
             if (regions.members && !dirty[size_t(c)]) children.local().push_back(c);  // not listed yet

@@ -30,7 +30,9 @@ struct bayes_sampler {
   vec3f sun_color = {1, 1, 1};  // the sun's irradiance over its luminance
   bool frozen = false;  // oracle mode: statistics and regions no longer change
   learn_timing timing;
-  std::vector<int> first_child, next_sibling;  // per pair: the fine pairs of a coarse pair, as a linked list
+  // Per pair: the fine pairs of a coarse pair as a linked list: a coarse pair's first child, a fine pair's next
+  // sibling (two levels: a coarse pair has no siblings, a fine one no children); invalid_id ends the list.
+  std::vector<int> child_link;
 
   // Fallback (bayes_params::fallback_ratio): once on, lights are chosen by power and nothing more is learned.
   power_sampler power;
