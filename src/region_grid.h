@@ -32,7 +32,7 @@ struct region_params {
   static constexpr int auto_members = 128;  // the default in direct illumination (max depth 1); 0 in path tracing
   int min_samples = 16;            // NEE samples a fine cell must ask for before its region is created
   int fine_depth = 1;              // path vertices up to this depth use fine regions, deeper ones coarse regions
-  int64_t max_pairs = int64_t(1) << 20;  // memory budget in (region, cluster) pairs
+  int64_t max_pairs = int64_t(3) << 19;  // memory budget in (region, cluster) pairs (1.5 M; see README)
 };
 
 // Cluster id of the sun inside a cut (tree nodes are >= 0).
