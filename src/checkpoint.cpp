@@ -102,7 +102,18 @@ void write_regions(writer& w, const region_state& s) {
   w.value(uint64_t(s.pending_count));
 }
 
-void read_regions(reader& r, region_state& s) {
+// Whether every value of a column is finite and not negative.
+template <class T>
+bool finite_non_negative(const std::vector<T>& v) {
+  for (T x : v)
+    if (!(std::isfinite(x) && x >= 0)) return false;
+  return true;
+}
+
+// A checksum guards against accidental damage only: every index the renderer follows is checked against the light
+// tree and the other columns, so that an edited checkpoint is an input error, never a crash or an endless loop.
+// `nodes`: the light tree's node count; `sun`: whether the scene has a sun (sun_cluster entries are then allowed).
+void read_regions(reader& r, region_state& s, int nodes, bool sun) {
   s.key = r.column<uint64_t>();
   size_t n = s.key.size();
   s.cut_offset = r.column<int>(n);
@@ -134,7 +145,45 @@ void read_regions(reader& r, region_state& s) {
         if (s.pair_slot[size_t(s.pair_offset[i] + k)] != s.cut_offset[i] + g) r.fail("region members");
     }
   }
+  // Regions hold consecutive runs of the pair columns, in region order (as they were appended); cuts may be shared
+  // (scenes with a handful of lights), and were checked to lie within the column above.
+  int64_t pairs = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (s.pair_offset[i] != pairs) r.fail("region layout");
+    pairs += s.pair_count[i];
+    if (s.parent[i] != invalid_id && (s.parent[i] < 0 || size_t(s.parent[i]) >= n || s.parent[size_t(s.parent[i])] != invalid_id))
+      r.fail("region parent");
+  }
+  if (pairs != s.pairs) r.fail("region layout");
+  // A region's clusters and members: tree nodes in increasing order, the sun (if any) last.
+  auto sorted_nodes = [&](const int* v, int count) {
+    for (int k = 0; k < count; k++) {
+      int node = v[k];
+      bool ok = node == sun_cluster ? sun && k == count - 1 : node >= 0 && node < nodes && (k == 0 || v[k - 1] < node);
+      if (!ok) return false;
+    }
+    return true;
+  };
+  for (size_t i = 0; i < n; i++)
+    if (!sorted_nodes(s.cut_nodes.data() + s.cut_offset[i], s.cut_size[i]) ||
+        !sorted_nodes(s.pair_node.data() + s.pair_offset[i], s.pair_count[i]))
+      r.fail("region clusters");
+  // A pair's parent: a pair without a parent of its own (two levels: the coarse pairs' lists of fine children
+  // cannot loop).
+  for (size_t k = 0; k < size_t(s.pairs); k++) {
+    int up = s.pair_parent[k];
+    if (up == invalid_id) continue;
+    if (up < 0 || up >= s.pairs || s.pair_parent[size_t(up)] != invalid_id) r.fail("pair parent");
+  }
+  // The pending table: a power of two at most half full (lookups stop at an empty slot), its count the slots in use.
   if (!s.pending.empty() && (s.pending.size() & (s.pending.size() - 1)) != 0) r.fail("pending table size");
+  size_t used = 0;
+  for (const region_slot& e : s.pending) {
+    if (e.key == empty_region_key) continue;
+    used++;
+    if (e.id < -1) r.fail("pending table");
+  }
+  if (used != s.pending_count || 2 * used > s.pending.size()) r.fail("pending table");
   // The lookup table is rebuilt from the keys (its layout does not matter, its answers do).
   rebuild_region_table(s);
 }
@@ -184,13 +233,14 @@ void write_sampler(writer& w, const light_sampler& ls) {
 }
 
 void read_sampler(reader& r, light_sampler& ls) {
-  if (auto* b = std::get_if<bound_sampler>(&ls)) read_regions(r, b->regions);
+  if (auto* b = std::get_if<bound_sampler>(&ls)) read_regions(r, b->regions, node_count(*b->tree), b->lights->sun != invalid_id);
   if (auto* b = std::get_if<bayes_sampler>(&ls)) {
-    read_regions(r, b->regions);
+    read_regions(r, b->regions, node_count(*b->tree), b->lights->sun != invalid_id);
     size_t pairs = size_t(b->regions.pairs);
     b->stats.m.assign(pairs, pair_moments{});
     for (int f = 0; f < 4; f++) {
       std::vector<double> col = r.column<double>(pairs);
+      if (!finite_non_negative(col)) r.fail("statistics");
       for (size_t i = 0; i < pairs; i++) moment_field(b->stats.m[i], f) = col[i];
     }
     std::vector<pair_weight> weight = r.column<pair_weight>(b->params.region_prior ? 0 : pairs);
@@ -233,11 +283,13 @@ void read_sampler(reader& r, light_sampler& ls) {
     b->refresh_groups(nullptr);  // the clusters' sums of the saved weights
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
-    read_regions(r, d->deeper.regions);
+    read_regions(r, d->deeper.regions, node_count(*d->deeper.tree), d->deeper.lights->sun != invalid_id);
     d->pixel_sum = r.column<float>(d->pixel_sum.size());
     d->pixel_count = r.column<float>(d->pixel_count.size());
     d->block_sum = r.column<float>(d->block_sum.size());
     d->block_count = r.column<float>(d->block_count.size());
+    for (const std::vector<float>* c : {&d->pixel_sum, &d->pixel_count, &d->block_sum, &d->block_count})
+      if (!finite_non_negative(*c)) r.fail("statistics");
   }
 }
 
@@ -307,7 +359,7 @@ std::string encode_checkpoint(uint64_t fingerprint, const render_result& result,
   return w.out;
 }
 
-void decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
+void decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint, double pass_weighting,
                        render_result& result, light_sampler& sampler) {
   if (bytes.size() < sizeof magic + 8 || std::memcmp(bytes.data(), magic, sizeof magic) != 0)
     throw input_error(path, "not a bayeslight checkpoint");
@@ -341,9 +393,34 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
   }
   result.film = r.column<double>(size_t(w) * size_t(hgt) * 3);
   result.film_weight = r.value<double>();
-  if (result.passes < 0 || result.spp < 0 || result.stratum_base < 0 || result.stratum_base > result.spp || !(result.film_weight >= 0) || (result.spp > 0) != (result.film_weight > 0))
-    r.fail("pass state");
+  // One log record per pass, numbered from 1, each adding samples; the set of stratified samples starts at a pass's
+  // end (or at 0).
+  bool passes_ok = result.passes >= 0 && uint64_t(result.passes) == result.log.size() &&
+                   std::isfinite(result.seconds) && result.seconds >= 0;
+  bool base_ok = result.stratum_base == 0;
+  int spp = 0;
+  double seconds = 0;
+  for (size_t i = 0; passes_ok && i < result.log.size(); i++) {
+    const pass_record& p = result.log[i];
+    passes_ok = p.pass == int(i) + 1 && p.spp > spp && std::isfinite(p.seconds) && p.seconds >= seconds &&
+                (!p.has_error || (std::isfinite(p.error.relmse) && std::isfinite(p.error.mse) && std::isfinite(p.error.maxabs)));
+    spp = p.spp, seconds = p.seconds;
+    base_ok = base_ok || result.stratum_base == p.spp;
+  }
+  if (!passes_ok || spp != result.spp || !base_ok) r.fail("pass state");
+  for (double x : result.film)
+    if (!std::isfinite(x)) r.fail("film");
   read_sampler(r, sampler);
+  // The film's weight is a function of the passes (their spp and the weighting fixed in advance): the same sum, in
+  // the same order, as the render's.
+  const double weighting = sampler_adapts(sampler) ? pass_weighting : 0.0;
+  double weight = 0;
+  spp = 0;
+  for (const pass_record& p : result.log) {
+    weight += pass_weight(spp, weighting) * (p.spp - spp);
+    spp = p.spp;
+  }
+  if (result.film_weight != weight) r.fail("film weight");
   if (auto* b = std::get_if<bayes_sampler>(&sampler); b && !b->px_var.empty() && b->px_var.size() != result.film.size() / 3)
     r.fail("fallback check");  // its columns are indexed by pixel
   if (r.pos != body.size()) r.fail("trailing data");

@@ -23,7 +23,8 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& params
 std::string encode_checkpoint(uint64_t fingerprint, const render_result& result, const light_sampler& sampler);
 // Restores a state written by encode_checkpoint into a freshly built sampler of the same kind and the result;
 // throws input_error naming `path` when the data are malformed or were written for another scene/options.
-void decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
+// `pass_weighting`: the render's (render_params::pass_weighting), against which the film's weight is checked.
+void decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint, double pass_weighting,
                        render_result& result, light_sampler& sampler);
 
 }  // namespace bl

@@ -220,7 +220,7 @@ int run_render(const render_options& o) {
   uint64_t fingerprint = render_fingerprint(scene, params);
   if (!o.resume.empty())
     params.restore = [&](render_result& r, light_sampler& s) {
-      decode_checkpoint(resume_bytes, o.resume, fingerprint, r, s);
+      decode_checkpoint(resume_bytes, o.resume, fingerprint, params.pass_weighting, r, s);
       // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
       if (params.time_budget <= 0 && r.spp > params.spp)
         throw usage_error("--spp " + std::to_string(params.spp) + " is below the " + std::to_string(r.spp) +

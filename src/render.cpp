@@ -255,6 +255,10 @@ int pass_size(int pass, int done) {
   return std::min(64, std::max(1, done / 4));
 }
 
+bool sampler_adapts(const light_sampler& s) {
+  return std::visit([](const auto& x) { return adapts(x); }, s);
+}
+
 double pass_weight(int done, double s) {
   // An adaptive sampler's first passes use the prior alone or models learned from a few samples: in the living
   // room (bayes, direct) the first 2 spp have ~50x the per-sample relMSE of later ones and make up a third of

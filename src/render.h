@@ -83,6 +83,8 @@ struct render_result {
 int pass_size(int pass, int done);
 // Weight of the samples of a pass that starts after `done` spp: (done + 1) / (done + 1 + s), 1 for s = 0.
 double pass_weight(int done, double s);
+// Whether the sampler's passes are weighted by pass_weight (an adaptive sampler that still learns).
+bool sampler_adapts(const light_sampler& s);
 
 // Renders the scene.
 render_result render(const scene_data& scene, const bvh_data& bvh, const light_data& lights,

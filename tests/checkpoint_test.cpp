@@ -2,9 +2,13 @@
 // (after a checkpoint) and resumed to the same spp is byte-identical to an uninterrupted one, for the learning
 // samplers too; a resume with another scene or other options, or from a corrupt file, is refused (exit 3).
 #include "file_io.h"
+#include "rng.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
 
 using namespace bl;
 using namespace bl::test;
@@ -104,5 +108,120 @@ TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[ch
     INFO(bad << "\n" << r.output);
     CHECK(r.status == 3);
     CHECK(r.output.find(bad) != std::string::npos);
+  }
+}
+
+namespace {
+
+// Checkpoint surgery for the test below: fields located by walking the layout of checkpoint.cpp, and the file
+// re-sealed with its checksum (the running hash: 8-byte words through mix64, then the length), so that only the
+// checks of the values themselves can refuse it.
+struct checkpoint_bytes {
+  std::string b;
+  size_t pos = 0;
+  template <class T>
+  T get(size_t at) const {
+    T v;
+    std::memcpy(&v, b.data() + at, sizeof v);
+    return v;
+  }
+  template <class T>
+  void put(size_t at, T v) {
+    std::memcpy(&b[at], &v, sizeof v);
+  }
+  size_t value(size_t size) { return (pos += size) - size; }
+  // Skips a column of `size`-byte entries; returns where its data start.
+  size_t column(size_t size) {
+    uint64_t n = get<uint64_t>(pos);
+    pos += 8;
+    size_t at = pos;
+    pos += n * size;
+    return at;
+  }
+  std::string sealed() const {
+    std::string body = b.substr(0, b.size() - 8);
+    uint64_t h = 0x243f6a8885a308d3ull;
+    for (size_t i = 0; i < body.size(); i += 8) {
+      uint64_t w = 0;
+      std::memcpy(&w, body.data() + i, std::min<size_t>(8, body.size() - i));
+      h = mix64(h ^ w);
+    }
+    h = mix64(h ^ body.size());
+    return body + std::string(reinterpret_cast<const char*>(&h), 8);
+  }
+};
+
+// Offsets of the fields the test edits.
+struct checkpoint_fields {
+  size_t passes, film, film_weight, cut_nodes, pair_parent, pending, pending_slots, moments;
+  uint64_t parents = 0;  // entries of the pair_parent column
+};
+checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
+  checkpoint_fields f{};
+  c.pos = 16 + 4 + 8 + 4 + 4 + 4;  // magic, version, fingerprint, sampler kind, width, height
+  f.passes = c.value(4);
+  c.value(4 + 4 + 8 + 6 * 8);  // spp, stratum base, seconds, counters
+  uint64_t log = c.get<uint64_t>(c.value(8));
+  c.value(log * (4 + 4 + 8 + 1 + 3 * 8));
+  f.film = c.column(8);
+  f.film_weight = c.value(8);
+  for (int k = 0; k < 5; k++) c.column(k == 0 ? 8 : 4);  // key, cut_offset, cut_size, pair_offset, parent
+  f.cut_nodes = c.column(4);
+  f.parents = c.get<uint64_t>(c.pos);
+  f.pair_parent = c.column(4);
+  c.value(8 + 1);                               // pairs, members
+  for (int k = 0; k < 4; k++) c.column(4);      // member_begin, pair_count, pair_node, pair_slot
+  f.pending_slots = c.get<uint64_t>(c.pos);
+  f.pending = c.column(16);                     // {key, id} slots
+  c.value(8);                                   // pending count
+  if (bayes) f.moments = c.column(8);           // n0
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed", "[checkpoint]") {
+  // Indices out of range crashed the resumed render, a full pending table or a pair whose parent has a parent made it
+  // loop for ever, non-finite film values gave NaN pixels: each is an input error naming the file now.
+  temp_dir d;
+  auto args = [&](const char* sampler) {
+    return "render " + source_path("data/cornell/direct.json") + " --sampler " + std::string(sampler) +
+           " --width 32 --height 24 --threads 1 --quiet";
+  };
+  for (const char* sampler : {"bound", "bayes"}) {
+    bool bayes = std::string(sampler) == "bayes";
+    std::string ck = d / "ck.bin";
+    REQUIRE(run_bayeslight(args(sampler) + " --spp 8 --checkpoint " + ck + " -o " + (d / "a.exr")).status == 0);
+    checkpoint_bytes base{read_file(ck)};
+    checkpoint_fields f = locate_fields(base, bayes);
+    REQUIRE(f.pending_slots >= 2);
+    std::vector<std::pair<std::string, checkpoint_bytes>> cases;
+    auto edit = [&](const std::string& name, auto change) {
+      checkpoint_bytes c = base;
+      change(c);
+      cases.push_back({name, c});
+    };
+    edit("cluster node out of range", [&](checkpoint_bytes& c) { c.put<int>(f.cut_nodes, 1000000); });
+    if (f.parents > 0) edit("pair parent below -1", [&](checkpoint_bytes& c) { c.put<int>(f.pair_parent, -2); });
+    edit("pending table full", [&](checkpoint_bytes& c) {
+      for (uint64_t k = 0; k < f.pending_slots; k++) c.put<uint64_t>(f.pending + 16 * k, k);
+    });
+    edit("film NaN", [&](checkpoint_bytes& c) { c.put<double>(f.film, std::nan("")); });
+    edit("film weight infinite", [&](checkpoint_bytes& c) { c.put<double>(f.film_weight, HUGE_VAL); });
+    edit("passes", [&](checkpoint_bytes& c) { c.put<int>(f.passes, 2147483647); });
+    if (bayes) edit("statistics NaN", [&](checkpoint_bytes& c) { c.put<double>(f.moments, std::nan("")); });
+    // The unedited file, re-sealed the same way, resumes: the edits alone are refused.
+    write_text(d / "same.bin", base.sealed());
+    auto ok = run_bayeslight(args(sampler) + " --spp 16 --resume " + (d / "same.bin") + " -o " + (d / "ok.exr"));
+    INFO(ok.output);
+    REQUIRE(ok.status == 0);
+    for (const auto& [name, c] : cases) {
+      write_text(d / "edited.bin", c.sealed());
+      auto r = run_bayeslight(args(sampler) + " --spp 16 --resume " + (d / "edited.bin") + " -o " + (d / "x.exr"));
+      INFO(sampler << ": " << name << "\n" << r.output);
+      CHECK(r.status == 3);
+      CHECK(r.output.find("edited.bin: corrupt checkpoint") != std::string::npos);
+      CHECK(!std::filesystem::exists(d / "x.exr"));
+    }
   }
 }
