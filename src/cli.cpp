@@ -282,6 +282,10 @@ const CLI::Validator finite_number(
     },
     "");
 
+// A file name that is not empty: an empty shell variable (--log "$LOG") would otherwise drop the option silently.
+const CLI::Validator file_name(
+    [](std::string& text) -> std::string { return text.empty() ? "an empty file name" : std::string(); }, "");
+
 // A finite number above 0 (CLI::PositiveNumber's message would print the largest double in full).
 const CLI::Validator positive_number(
     [](std::string& text) -> std::string {
@@ -410,20 +414,23 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required();
   r->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)");
   r->add_option("-o,--output", o.outputs, ".exr/.pfm (linear float RGB) or .png (8-bit sRGB); repeatable");
-  r->add_option("--reference", o.reference, "Reference .exr/.pfm of the same size: error after every pass");
-  r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse");
+  r->add_option("--reference", o.reference, "Reference .exr/.pfm of the same size: error after every pass")
+      ->check(file_name);
+  r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse")->check(file_name);
   r->add_option("--frames", o.frames,
                 "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
                 "and --reference then take a frame pattern such as out_%04d.exr")
       ->check(CLI::Range(1, 100000));
   r->add_option("--checkpoint", o.checkpoint,
                 "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
-                "and at the end); --resume continues it");
+                "and at the end); --resume continues it")
+      ->check(file_name);
   r->add_option("--checkpoint-every", o.checkpoint_every, "Seconds between checkpoints (default 30; 0: every pass)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number);
   r->add_option("--resume", o.resume,
                 "Continue the render saved in FILE (same scene and options; --spp may be larger: the same bytes as one render "
-                "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...)");
+                "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...)")
+      ->check(file_name);
   r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes")
       ->group("");
   r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")
@@ -466,7 +473,9 @@ void add_compare_command(CLI::App& app, compare_options& o) {
   CLI::App* c = app.add_subcommand("compare", "Render several samplers for the same time (or spp) against a "
                                               "reference: curves.csv, error_vs_time.svg, summary.md, images");
   c->add_option("SCENE", o.render.scene, "Scene file (.json) or mesh (.obj)")->required();
-  c->add_option("--reference", o.render.reference, "Reference .exr/.pfm of the render's size")->required();
+  c->add_option("--reference", o.render.reference, "Reference .exr/.pfm of the render's size")
+      ->required()
+      ->check(file_name);
   c->add_option("--samplers", o.samplers, "Comma-separated samplers, the first is the baseline: " + sampler_names())
       ->required()->delimiter(',');
   c->add_option("--out", o.out, "Output directory (created if missing)")->required();

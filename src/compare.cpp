@@ -295,6 +295,10 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
     }
     for (const char* f : {curves_file, plot_file, summary_file}) outs.push_back({out_path(params, f), "output"});
     check_distinct_outputs(outs, ins);
+    // An output name taken by a directory would only fail after every render: refused before the first.
+    std::error_code ec;
+    for (const auto& o : outs)
+      if (fs::is_directory(o.first, ec)) throw output_error("cannot write " + o.first + ": is a directory");
   }
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);

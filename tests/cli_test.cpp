@@ -123,6 +123,11 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --seed -1", "--seed"},
       {"render " + s.json + " --seed 18446744073709551616", "--seed"},
       {"render " + s.json + " --seed 1e3", "--seed"},
+      // An empty file name (an unset shell variable) is an error, not an option left out.
+      {"render " + s.json + " --log \"\"", "--log: an empty file name"},
+      {"render " + s.json + " --reference \"\"", "--reference: an empty file name"},
+      {"render " + s.json + " --checkpoint \"\"", "--checkpoint: an empty file name"},
+      {"render " + s.json + " --resume \"\"", "--resume: an empty file name"},
       {"frobnicate", "frobnicate"},
   };
   for (const auto& c : cases) {

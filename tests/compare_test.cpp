@@ -385,6 +385,19 @@ TEST_CASE("bad compare invocations exit 2 or 3 and write nothing", "[compare]") 
     CHECK(r.output.find(c.expect) != std::string::npos);
     CHECK(!std::filesystem::exists(out));
   }
+  // An output name taken by a directory is refused before any render (it failed after all of them, leaving the
+  // images without the curves and summary).
+  for (const char* taken : {"curves.csv", "bvh.exr", "uniform_error.png"}) {
+    std::string out2 = s.dir / "out2";
+    std::filesystem::remove_all(out2);
+    std::filesystem::create_directories(std::filesystem::path(out2) / taken);
+    run_result r = run_bayeslight("compare " + s.json + " --out " + out2 + " --quiet --reference " + s.ref +
+                                  " --spp 2 --samplers uniform,bvh");
+    INFO(taken << "\n" << r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find(std::string(taken) + ": is a directory") != std::string::npos);
+    CHECK(!std::filesystem::exists(std::filesystem::path(out2) / "uniform.exr"));
+  }
 }
 
 TEST_CASE("time to reach a target error interpolates log-log between passes", "[compare]") {
