@@ -184,6 +184,10 @@ int run_render(const render_options& o) {
 
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
+  if (o.frames > 1 && !(desc.sun.enabled && desc.sun.animated))
+    std::fprintf(stderr, "%s: warning: %s, so the %d frames are the same image (the sun moves to sun.direction_end)\n",
+                 o.scene.c_str(), desc.sun.enabled ? "the sun has no \"direction_end\"" : "the scene has no sun",
+                 o.frames);
   std::vector<image_data> references;
   if (!o.reference.empty())
     for (int f = 0; f < params.frames; f++)

@@ -129,3 +129,17 @@ TEST_CASE("without --frames an output name is taken literally, % and all", "[ani
   CHECK_FALSE(std::filesystem::exists(a.dir / "still_0.pfm"));
   CHECK_FALSE(std::filesystem::exists(a.dir / "still_00.csv"));
 }
+
+TEST_CASE("frames of a sun that does not move are rendered with a warning", "[animation]") {
+  // A sun without direction_end gives every frame the same image: rendered (it is no error), but said.
+  anim_scene a;
+  std::string still = a.scene("still.json", sun_start, nullptr), anim = a.scene("anim.json", sun_start, &sun_end);
+  auto r = run_bayeslight("render " + still + " --frames 2 --spp 1 --quiet -o " + (a.dir / "s_%d.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("warning: the sun has no \"direction_end\"") != std::string::npos);
+  CHECK(std::filesystem::exists(a.dir / "s_1.pfm"));
+  auto moving = run_bayeslight("render " + anim + " --frames 2 --spp 1 --quiet -o " + (a.dir / "m_%d.pfm"));
+  CHECK(moving.status == 0);
+  CHECK(moving.output.find("warning") == std::string::npos);
+}
