@@ -151,8 +151,8 @@ void read_regions(reader& r, region_state& s, int nodes, bool sun) {
   for (size_t i = 0; i < n; i++) {
     if (s.pair_offset[i] != pairs) r.fail("region layout");
     pairs += s.pair_count[i];
-    if (s.parent[i] != invalid_id && (s.parent[i] < 0 || size_t(s.parent[i]) >= n || s.parent[size_t(s.parent[i])] != invalid_id))
-      r.fail("region parent");
+    int up = s.parent[i];
+    if (up != invalid_id && (up < 0 || size_t(up) >= n || s.parent[size_t(up)] != invalid_id)) r.fail("region parent");
   }
   if (pairs != s.pairs) r.fail("region layout");
   // A region's clusters and members: tree nodes in increasing order, the sun (if any) last.
@@ -233,7 +233,8 @@ void write_sampler(writer& w, const light_sampler& ls) {
 }
 
 void read_sampler(reader& r, light_sampler& ls) {
-  if (auto* b = std::get_if<bound_sampler>(&ls)) read_regions(r, b->regions, node_count(*b->tree), b->lights->sun != invalid_id);
+  if (auto* b = std::get_if<bound_sampler>(&ls))
+    read_regions(r, b->regions, node_count(*b->tree), b->lights->sun != invalid_id);
   if (auto* b = std::get_if<bayes_sampler>(&ls)) {
     read_regions(r, b->regions, node_count(*b->tree), b->lights->sun != invalid_id);
     size_t pairs = size_t(b->regions.pairs);
@@ -402,8 +403,9 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
   double seconds = 0;
   for (size_t i = 0; passes_ok && i < result.log.size(); i++) {
     const pass_record& p = result.log[i];
-    passes_ok = p.pass == int(i) + 1 && p.spp > spp && std::isfinite(p.seconds) && p.seconds >= seconds &&
-                (!p.has_error || (std::isfinite(p.error.relmse) && std::isfinite(p.error.mse) && std::isfinite(p.error.maxabs)));
+    bool errors_ok = !p.has_error || (std::isfinite(p.error.relmse) && std::isfinite(p.error.mse) &&
+                                      std::isfinite(p.error.maxabs));
+    passes_ok = p.pass == int(i) + 1 && p.spp > spp && std::isfinite(p.seconds) && p.seconds >= seconds && errors_ok;
     spp = p.spp, seconds = p.seconds;
     base_ok = base_ok || result.stratum_base == p.spp;
   }
