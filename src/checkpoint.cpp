@@ -337,6 +337,12 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   return h.h;
 }
 
+uint64_t checkpoint_checksum(std::string_view body) {
+  hasher h;
+  h.bytes(body.data(), body.size());
+  return h.h;
+}
+
 std::string encode_checkpoint(uint64_t fingerprint, const render_result& result, const light_sampler& sampler) {
   writer w;
   w.out.append(magic, sizeof magic);
@@ -354,9 +360,7 @@ std::string encode_checkpoint(uint64_t fingerprint, const render_result& result,
   w.column(result.film);
   w.value(result.film_weight);
   write_sampler(w, sampler);
-  hasher h;
-  h.bytes(w.out.data(), w.out.size());
-  w.value(h.h);
+  w.value(checkpoint_checksum(w.out));
   return w.out;
 }
 
@@ -364,11 +368,9 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
                        render_result& result, light_sampler& sampler) {
   if (bytes.size() < sizeof magic + 8 || std::memcmp(bytes.data(), magic, sizeof magic) != 0)
     throw input_error(path, "not a bayeslight checkpoint");
-  hasher h;
-  h.bytes(bytes.data(), bytes.size() - 8);
   uint64_t stored;
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
-  if (stored != h.h) throw input_error(path, "corrupt checkpoint: checksum mismatch");
+  if (stored != checkpoint_checksum(std::string_view(bytes).substr(0, bytes.size() - 8))) throw input_error(path, "corrupt checkpoint: checksum mismatch");
   std::string body = bytes.substr(0, bytes.size() - 8);
   reader r{body, path, sizeof magic};
   if (r.value<uint32_t>() != version) throw input_error(path, "checkpoint of another bayeslight version");

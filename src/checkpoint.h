@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace bl {
 
@@ -18,6 +19,9 @@ namespace bl {
 // (geometry, materials, textures, camera, sun) and the options that affect pixels (size, depth, seed, sampler
 // and its parameters). The spp target and time budget are not part of it: a render may be resumed further.
 uint64_t render_fingerprint(const scene_data& scene, const render_params& params);
+
+// The checksum a checkpoint ends with, of everything before it (a guard against accidental damage, not a seal).
+uint64_t checkpoint_checksum(std::string_view body);
 
 // Serialises a completed-pass state: the result so far and the sampler's learned state.
 std::string encode_checkpoint(uint64_t fingerprint, const render_result& result, const light_sampler& sampler);

@@ -1,8 +1,8 @@
 // Resumable renders: a render interrupted by SIGINT (checkpoint written on the way out) or killed by SIGKILL
 // (after a checkpoint) and resumed to the same spp is byte-identical to an uninterrupted one, for the learning
 // samplers too; a resume with another scene or other options, or from a corrupt file, is refused (exit 3).
+#include "checkpoint.h"
 #include "file_io.h"
-#include "rng.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
@@ -114,8 +114,7 @@ TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[ch
 namespace {
 
 // Checkpoint surgery for the test below: fields located by walking the layout of checkpoint.cpp, and the file
-// re-sealed with its checksum (the running hash: 8-byte words through mix64, then the length), so that only the
-// checks of the values themselves can refuse it.
+// re-sealed with its checksum, so that only the checks of the values themselves can refuse it.
 struct checkpoint_bytes {
   std::string b;
   size_t pos = 0;
@@ -140,13 +139,7 @@ struct checkpoint_bytes {
   }
   std::string sealed() const {
     std::string body = b.substr(0, b.size() - 8);
-    uint64_t h = 0x243f6a8885a308d3ull;
-    for (size_t i = 0; i < body.size(); i += 8) {
-      uint64_t w = 0;
-      std::memcpy(&w, body.data() + i, std::min<size_t>(8, body.size() - i));
-      h = mix64(h ^ w);
-    }
-    h = mix64(h ^ body.size());
+    uint64_t h = checkpoint_checksum(body);
     return body + std::string(reinterpret_cast<const char*>(&h), 8);
   }
 };
