@@ -417,7 +417,12 @@ void add_render_command(CLI::App& app, render_options& o) {
   CLI::App* r = app.add_subcommand("render", "Render a scene (.json scene file or bare .obj)");
   r->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required();
   r->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)");
-  r->add_option("-o,--output", o.outputs, ".exr/.pfm (linear float RGB) or .png (8-bit sRGB); repeatable");
+  // One file per -o (a vector option would otherwise also take the scene after it: `render -o a.exr SCENE`).
+  r->add_option("-o,--output", o.outputs,
+                ".exr/.pfm (linear float RGB) or .png (8-bit sRGB, clamped); repeatable, one file each (default: "
+                "SCENE's name with .exr, in the current directory)")
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   r->add_option("--reference", o.reference, "Reference .exr/.pfm of the same size: error after every pass")
       ->check(file_name);
   r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse")->check(file_name);
@@ -481,7 +486,7 @@ void add_compare_command(CLI::App& app, compare_options& o) {
       ->required()
       ->check(file_name);
   c->add_option("--samplers", o.samplers, "Comma-separated samplers, the first is the baseline: " + sampler_names())
-      ->required()->delimiter(',');
+      ->required()->delimiter(',')->allow_extra_args(false);
   c->add_option("--out", o.out, "Output directory (created if missing)")->required();
   c->add_option("--runs", o.runs, "Runs per sampler, seeds base, base+1, ... (default 1)")->check(CLI::Range(1, 10000));
   c->add_option("--reference-note", o.reference_note, "How the reference was made, for summary.md");

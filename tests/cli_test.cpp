@@ -88,6 +88,23 @@ TEST_CASE("the log carries error against a reference and diff reports it", "[cli
   CHECK(same.output.find("identical") != std::string::npos);
 }
 
+TEST_CASE("options may come before the scene: -o and --samplers take one value each", "[cli]") {
+  tiny_scene s;
+  auto r = run_bayeslight("render -o " + (s.dir / "a.pfm") + " -o " + (s.dir / "a.png") + " --spp 1 " + s.json +
+                          " --quiet");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(exists(s.dir / "a.pfm"));
+  CHECK(exists(s.dir / "a.png"));
+  auto ref = run_bayeslight("render " + s.json + " --spp 8 --quiet -o " + (s.dir / "ref.pfm"));
+  REQUIRE(ref.status == 0);
+  auto c = run_bayeslight("compare --samplers power,uniform " + s.json + " --reference " + (s.dir / "ref.pfm") +
+                          " --spp 1 --out " + (s.dir / "cmp"));
+  INFO(c.output);
+  CHECK(c.status == 0);
+  CHECK(exists(s.dir / "cmp/summary.md"));
+}
+
 TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
   tiny_scene s;
   struct bad_case {
@@ -128,6 +145,8 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --reference \"\"", "--reference: an empty file name"},
       {"render " + s.json + " --checkpoint \"\"", "--checkpoint: an empty file name"},
       {"render " + s.json + " --resume \"\"", "--resume: an empty file name"},
+      // One file per -o: a second name is not taken as another output.
+      {"render " + s.json + " -o " + (s.dir / "a.exr") + " " + (s.dir / "b.exr"), "b.exr"},
       {"frobnicate", "frobnicate"},
   };
   for (const auto& c : cases) {
