@@ -371,13 +371,17 @@ image_data read_reference(const std::string& path, int width, int height) {
   if (ref.width != width || ref.height != height)
     throw input_error(path, "reference is " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
                                 " but the render is " + std::to_string(width) + "x" + std::to_string(height));
-  for (size_t i = 0; i < ref.pixels.size(); i++)
-    if (!std::isfinite(ref.pixels[i])) {
-      size_t px = i / 3;
-      throw input_error(path, "reference has a non-finite value at pixel (" + std::to_string(px % size_t(width)) +
-                                  ", " + std::to_string(px / size_t(width)) + ")");
-    }
+  require_finite(ref, path, "reference");
   return ref;
+}
+
+void require_finite(const image_data& img, const std::string& path, const std::string& what) {
+  for (size_t i = 0; i < img.pixels.size(); i++)
+    if (!std::isfinite(img.pixels[i])) {
+      size_t px = i / 3, w = size_t(std::max(img.width, 1));
+      throw input_error(path, what + " has a non-finite value at pixel (" + std::to_string(px % w) + ", " +
+                                  std::to_string(px / w) + ")");
+    }
 }
 
 }  // namespace bl

@@ -23,6 +23,8 @@ image_data read_image(const std::string& path);
 // Reads a reference image for a render of width x height: its size must match and every value be finite (a
 // NaN would make every error figure NaN); throws input_error naming the file otherwise.
 image_data read_reference(const std::string& path, int width, int height);
+// Throws input_error (exit 3) naming `path` and the first pixel (x, y from the top) with a NaN or infinite value.
+void require_finite(const image_data& img, const std::string& path, const std::string& what);
 // Writes by extension (.exr fp32, .pfm, .png sRGB 8-bit clamped); atomic; throws output_error on failure.
 void write_image(const std::string& path, const image_data& img);
 

@@ -13,6 +13,10 @@
 
 namespace bl {
 
+// Why load_obj drops a triangle as degenerate: the renderer's float maths squares a triangle's doubled area
+// (|cross|^2), which must be a positive finite float.
+extern const char* const degenerate_reason;
+
 // One OBJ material (MTL statement names in comments). Colours are linear RGB; a statement the MTL omits keeps
 // the default below.
 struct material_data {
@@ -38,7 +42,7 @@ struct mesh_data {
   std::vector<int> tri_materials; // 1 per triangle: index into materials
   std::vector<material_data> materials;
   std::vector<texture_data> textures;
-  int dropped_degenerate = 0;     // zero-area or non-finite triangles removed on load
+  int dropped_degenerate = 0;     // zero-area or non-finite triangles removed on load (degenerate_reason)
   std::vector<std::string> source_files;  // the OBJ, the MTL files of its used materials, their textures
 };
 

@@ -1,6 +1,8 @@
 // report: CSV and summary formatting (numbers with enough digits to round-trip).
 #include "report.h"
 
+#include "obj_io.h"
+
 #include <sys/resource.h>
 
 #include <cstdio>
@@ -71,8 +73,9 @@ std::string render_summary(const render_result& r, const std::vector<std::string
 
 void report_dropped_triangles(const std::string& mesh_path, int dropped) {
   if (dropped > 0)
-    std::fprintf(stderr, "%s: dropped %d degenerate triangle%s (zero area in float, or an area too large for it)\n", mesh_path.c_str(), dropped,
-                 dropped == 1 ? "" : "s");
+    std::fprintf(stderr,
+                 "%s: dropped %d degenerate triangle%s (%s)\n", mesh_path.c_str(), dropped, dropped == 1 ? "" : "s",
+                 degenerate_reason);
 }
 
 }  // namespace bl

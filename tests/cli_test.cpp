@@ -228,6 +228,21 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
   CHECK(r.status == 3);
   CHECK(r.output.find("nan.pfm: reference has a non-finite value at pixel (5, 2)") != std::string::npos);
   CHECK(!exists(s.dir / "out.exr"));
+  // diff names a non-finite pixel of either image instead of printing relmse=nan.
+  nan_ref.pixels[3 * (2 * 16 + 5) + 1] = 0.5f;
+  nan_ref.pixels[3 * (7 * 16 + 9)] = -INFINITY;
+  write_image(s.dir / "inf.pfm", nan_ref);
+  nan_ref.pixels[3 * (7 * 16 + 9)] = 0.5f;
+  write_image(s.dir / "ok.pfm", nan_ref);
+  for (std::string args : {"ok.pfm inf.pfm", "inf.pfm ok.pfm"}) {
+    auto d2 = run_bayeslight("diff " + (s.dir / args.substr(0, args.find(' '))) + " " +
+                             (s.dir / args.substr(args.find(' ') + 1)));
+    INFO(args << "\n" << d2.output);
+    CHECK(d2.status == 3);
+    CHECK(d2.output.find("inf.pfm: image has a non-finite value at pixel (9, 7)") != std::string::npos);
+    CHECK(d2.output.find("relmse") == std::string::npos);
+  }
+  CHECK(run_bayeslight("diff " + (s.dir / "ok.pfm") + " " + (s.dir / "ok.pfm")).status == 0);
 }
 
 TEST_CASE("a camera given in part takes the framing of a bare OBJ for the rest", "[cli]") {
