@@ -379,14 +379,20 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       if (((k == "d" && v < 1) || (k == "Tr" && v > 0)) && transparent_line == 0) transparent_line = lines.line;
     }
   }
-  // Kd + Ks above 1 reflects more than arrives: make_bsdf scales such a material down (said once per file).
+  // Kd + Ks above 1 reflects more than arrives: make_bsdf scales such a material down (one line per file, naming
+  // the first few).
+  std::vector<std::string> bright;
   for (size_t i = first; i < out.size(); i++) {
     const material_data& m = out[i].material;
-    if (std::max({m.kd.x + m.ks.x, m.kd.y + m.ks.y, m.kd.z + m.ks.z}) > 1) {
-      std::cerr << "warning: " << path << ": material " << quote(m.name)
-                << " has Kd + Ks above 1, scaled down to conserve energy\n";
-      break;
-    }
+    if (std::max({m.kd.x + m.ks.x, m.kd.y + m.ks.y, m.kd.z + m.ks.z}) > 1) bright.push_back(quote(m.name));
+  }
+  if (!bright.empty()) {
+    constexpr size_t named = 5;
+    std::string list;
+    for (size_t i = 0; i < std::min(bright.size(), named); i++) list += (i > 0 ? ", " : "") + bright[i];
+    if (bright.size() > named) list += " and " + std::to_string(bright.size() - named) + " more";
+    std::cerr << "warning: " << path << ": material" << (bright.size() > 1 ? "s " : " ") << list
+              << (bright.size() > 1 ? " have" : " has") << " Kd + Ks above 1, scaled down to conserve energy\n";
   }
   if (transparent_line > 0)
     std::cerr << "warning: " << path << ":" << transparent_line

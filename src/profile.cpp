@@ -178,7 +178,10 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
            "here)\n", t_raw / (t_raw + t_cam), t_cam / t_raw);
   }
   line("  between-pass learning: %.2f%% of the plain render's time\n", 100 * a.learn_seconds / std::max(a.seconds, 1e-9));
-  line("  timers cost: the timed render took %.1f%% longer than the plain one\n", 100 * (b.seconds / a.seconds - 1));
+  double extra = 100 * (b.seconds / a.seconds - 1);
+  if (extra >= 0) line("  timers cost: the timed render took %.1f%% longer than the plain one\n", extra);
+  else  // the timers' cost is below the machine's noise on a render this short
+    line("  timers cost: the timed render took %.1f%% less time than the plain one (noise)\n", -extra);
   if (a.regions > 0)
     line("  sampler state: %.2f MB; %d regions, %lld (region, cluster) pairs, %.1f bytes per pair\n",
          double(a.sampler_bytes) / (1 << 20), a.regions, (long long)a.pairs,

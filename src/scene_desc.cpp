@@ -58,7 +58,8 @@ void check_keys(const desc_context& ctx, const json& obj, const std::string& whe
 float get_number(const desc_context& ctx, const json& v, const std::string& key) {
   if (!v.is_number()) ctx.fail(key, "\"" + key + "\" must be a number");
   double d = v.get<double>();
-  if (!std::isfinite(d) || std::fabs(d) > 1e30) ctx.fail(key, "\"" + key + "\" must be a finite number");
+  if (!std::isfinite(d) || std::fabs(d) > 1e30)
+    ctx.fail(key, "\"" + key + "\" must be a finite number of magnitude at most 1e30");
   return float(d);
 }
 

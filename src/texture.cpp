@@ -146,6 +146,10 @@ static std::string stb_reason() {
   // stb_image quotes a corrupt file's own bytes (an unknown chunk's type): keep the message printable.
   for (char& c : s)
     if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+  // Its reasons are terse: say what they mean where that is clear (the file's magic bytes were accepted already).
+  if (s.size() <= 4) return "corrupt or truncated file (an unexpected chunk \"" + s + "\")";
+  if (s == "unknown image type") return "corrupt file, or a variant of its format stb_image does not read";
+  if (s == "outofdata" || s == "read past buffer" || s == "not enough pixels") return "truncated file (" + s + ")";
   return s;
 }
 

@@ -452,6 +452,12 @@ TEST_CASE("materials the renderer changes or ignores are named in a warning", "[
   REQUIRE(r.status == 0);
   CHECK(r.output.find("material 'floor' has Kd + Ks above 1, scaled down to conserve energy") != std::string::npos);
   CHECK(r.output.find("box.mtl:4: dissolve") != std::string::npos);
+  // Every such material is named, in one line.
+  write_text(s.dir / "box.mtl", "newmtl floor\nKd 0.9 0.5 0.5\nKs 0.3\nnewmtl lamp\nKd 0.8 0 0\nKs 0.4\nKe 5 5 5\n");
+  r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "o.pfm"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("materials 'floor', 'lamp' have Kd + Ks above 1, scaled down") != std::string::npos);
   // A material the library does not define: its faces get the default material, said at the usemtl's line. The
   // lamp named so no longer emits: the image is black where it was lit.
   write_text(s.dir / "box.mtl", "newmtl floor\nKd 0.5 0.5 0.5\n");
