@@ -527,6 +527,16 @@ int run_compare_command(const compare_options& o) {
 int run_cli(int argc, char** argv) {
   CLI::App app{"bayeslight — deterministic path tracer with Bayesian light selection for NEE"};
   app.require_subcommand(1);
+  app.footer(
+      "Examples:\n"
+      "  bayeslight render scene.json -o out.exr --spp 256\n"
+      "  bayeslight render scene.json --time 10 --reference ref.exr --log log.csv -o out.png\n"
+      "  bayeslight compare scene.json --reference ref.exr --time 10 --samplers bound,bayes --out cmp\n"
+      "  bayeslight diff out.exr ref.exr\n"
+      "Each command's options: bayeslight COMMAND --help.\n"
+      "Exit status: 0 success; 1 other failure (e.g. an output that cannot be written); 2 bad command line; 3 bad "
+      "input (the message names the file and line); 130/143 interrupted (SIGINT/SIGTERM), after writing the image of "
+      "the passes completed.");
   render_options ro;
   diff_options dopt;
   compare_options copt;
