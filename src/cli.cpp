@@ -311,7 +311,9 @@ void add_render_options(CLI::App* r, render_options& o) {
   auto* time = r->add_option("--time", o.time, "Render whole passes until this many seconds are spent")
                    ->check(CLI::Range(1e-6, 1e9))->check(finite_number);
   spp->excludes(time);
-  r->add_option("--max-depth", o.max_depth, "Path length in segments; 1 = direct illumination only (camera ray, NEE and emission seen), 2 adds one bounce")
+  r->add_option("--max-depth", o.max_depth,
+                "Path length in segments; 1 = direct illumination only (camera ray, NEE and emission seen), 2 adds "
+                "one bounce")
       ->check(CLI::Range(1, 1000));
   r->add_option("--threads", o.threads, "Worker threads (default: all cores); never changes the image")
       ->check(CLI::Range(1, 4096));

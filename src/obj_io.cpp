@@ -143,7 +143,7 @@ static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& 
 }
 
 const char* const degenerate_reason =
-    "zero area, or an area float maths cannot square: outside about 1e-22 to 1e19 square units; rescale the scene";
+    "zero area, or an area float maths cannot square: outside about 2e-23 to 9e18 square units; rescale the scene";
 
 // True when triangle (a, b, c) has finite, non-zero area in float: |cross|^2 is a positive finite float.
 static bool good_triangle(vec3f a, vec3f b, vec3f c) {
@@ -330,7 +330,8 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   if (mesh.tri_materials.empty())
     throw input_error(path,
                       "no triangles" + (mesh.dropped_degenerate > 0
-                                            ? " (" + std::to_string(mesh.dropped_degenerate) + " degenerate dropped: " + degenerate_reason + ")"
+                                            ? " (" + std::to_string(mesh.dropped_degenerate) +
+                                                  " degenerate dropped: " + degenerate_reason + ")"
                                             : std::string()));
 
   // Compact each vertex array to the referenced elements, keeping file order.
