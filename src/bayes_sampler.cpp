@@ -134,7 +134,7 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   if (!finish_cdf(ctx, w)) finish_cdf(ctx, b);
 }
 
-void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) const {
+void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bool cv_allowed) const {
   // w_j = W_j g_j with g_j = 1 / max(|p - c_j|^2, r_j^2) (1 without the regression), and 0 when the cluster's
   // bounding sphere lies entirely behind the surface: dot(n, p - c_j) >= r_j (plus a rounding slack), where no
   // light of it can give a non-zero sample (the BSDF is zero below the geometric tangent plane). Four tree
@@ -145,7 +145,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
   // its clusters, each as a cluster of its own.
   size_t base = size_t(ctx.pair_base);
   const bool gloss = params.bsdf_factor && sp.gloss_peak > 0;
-  ctx.cv = params.control_variate && sp.last && !gloss;
+  ctx.cv = params.control_variate && sp.last && !gloss && cv_allowed;
   if (gloss && ctx.pair_count != ctx.count && ctx.pair_count <= max_cut_entries) {
     // A glossy point weighs every member as its own cluster (with its own lobe factor): which lights a highlight
     // mirrors changes faster across a region than the members' region-wide weights can follow.
@@ -243,6 +243,11 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp) co
       if (ctx.cvg[tc] != 0) cv_sum += cluster_color(ctx, sun_member) * ctx.cvg[tc];
     }
   }
+  if (ctx.cv && !is_finite(cv_sum)) {
+    // Learned means times this point's factors overflow float (absurd radiance scales): weigh it without them.
+    prepare_region_prior(ctx, sp, false);
+    return;
+  }
   ctx.cv_sum = cv_sum;
   if (front_mask == 0) {
     // Every cluster lies behind the surface: no light can be sampled (what the fallbacks below would also find).
@@ -282,7 +287,7 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
     double a = e.added, p = e.choice.prob;
     double q = power.pmf({}, e.choice.light);
     double with_power = a == 0 ? 0.0 : q > 0 ? a * a * p / q : HUGE_VAL;
-    px_delta[size_t(e.pixel)] += float(with_power - double(e.added_total) * e.added_total);
+    px_delta[size_t(e.pixel)] += with_power - double(e.added_total) * e.added_total;
   }
   const cut_context& ctx = *e.context;
   row.requests.add(ctx);
@@ -435,18 +440,20 @@ void bayes_sampler::sample_done(row_state& row, int pixel, vec3f l) const {
 void bayes_sampler::flush_check(const row_state& row) const {
   size_t i = size_t(row.check_pixel);
   if (row.check_n >= 2) {
-    px_var[i] = float(row.check_pending());
+    px_var[i] = row.check_pending();
     return;
   }
   // One sample in this pass: half the squared difference to the pixel's sample of the pass before (both passes of
   // one spp) is an unbiased estimate of its variance.
   float y = float(row.check_mean);
-  px_var[i] = std::isfinite(px_prev[i]) ? 0.5f * (y - px_prev[i]) * (y - px_prev[i]) : 0.0f;
-  px_prev[i] = y;
+  double d = double(y) - px_prev[i];
+  px_var[i] = std::isfinite(px_prev[i]) ? 0.5 * d * d : 0.0;
+  px_cur[i] = y;
 }
 
 void bayes_sampler::restart_check() {
-  px_var = px_delta = px_prev = {};
+  px_var = px_delta = {};
+  px_prev = px_cur = {};
   fallback_votes = 0;
   check_done = check_pairs = false;
   window_var = window_delta = window_samples = 0;
@@ -462,6 +469,7 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     for (const row_state& r : rows)
       if (r.check_pixel >= 0) flush_check(r);
     check_pairs = pass_spp == 1;  // the next pass of one spp has this pass's samples to pair with
+    if (pass_spp == 1 && px_cur.size() == n) px_prev.swap(px_cur);  // (every pixel had its one sample)
   }
   if (px_var.size() == n && paired && spp >= 4) {
     // Summed over the pass's samples with relMSE's weights 1 / (m^2 + 0.01), m the pixel's mean luminance with this
@@ -494,13 +502,15 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
       px_var = {};
       px_delta = {};
       px_prev = {};
+      px_cur = {};
       return;
     }
   }
-  px_var.assign(n, 0.0f);
-  px_delta.assign(n, 0.0f);
+  px_var.assign(n, 0.0);
+  px_delta.assign(n, 0.0);
   if (pass_spp == 1 && px_prev.size() != n) px_prev.assign(n, NAN);
-  if (pass_spp > 1) px_prev = {};
+  if (pass_spp == 1 && px_cur.size() != n) px_cur.assign(n, NAN);
+  if (pass_spp > 1) px_prev = {}, px_cur = {};
 }
 
 void bayes_sampler::begin_frame(double decay) {

@@ -45,8 +45,10 @@ struct bayes_sampler {
   // Per pixel, for the fallback check of the current pass (empty while it does not run): the sum over its samples
   // of their luminance's variance, and of its NEE events' second-moment change under power sampling. Each pixel is
   // written by the one task rendering its row (no races), and summed in pixel order.
-  mutable std::vector<float> px_var, px_delta;
+  mutable std::vector<double> px_var, px_delta;  // (double: squares of radiance beyond float's range)
   mutable std::vector<float> px_prev;  // passes of one spp: each pixel's sample luminance in the pass before (NaN: none)
+  mutable std::vector<float> px_cur;   // ... and in the pass being rendered, which becomes px_prev once the pass is
+                                       // complete (check_fallback): an interrupted pass leaves px_prev as it was
   bool check_pairs = false;            // the last pass had one spp: px_prev holds its samples
   void flush_check(const row_state& row) const;
   // Forgets the check's state (a new frame: its film starts empty); the fallback itself stays.
@@ -59,7 +61,8 @@ struct bayes_sampler {
   // Region-prior mode's weights at a point (prepare's fast path): W of each pair times its point factor (1 / d^2, the
   // receiver's cosine bound, and at a glossy point the Phong lobe's bound: over the members where the region has
   // them), zero for clusters entirely behind the point's surface.
-  void prepare_region_prior(context& ctx, const shade_point& sp) const;
+  // `cv_allowed` false: no control variates at this point (their sum at it is beyond float).
+  void prepare_region_prior(context& ctx, const shade_point& sp, bool cv_allowed = true) const;
   // A cluster by the point's cdf, then (a cluster of several members) a member by its weight, the cluster's share
   // of u rescaled to [0, 1) choosing it (so a stratified u stays stratified inside the cluster), then a light of the
   // member by intensity. light_choice::cluster is the member (the pair within the region).

@@ -43,6 +43,11 @@ void decay_stats(bayes_stats& s, double gamma) {
 }
 
 pair_coeffs pair_coefficients(const pair_moments& m, const bayes_params& p) {
+  pair_coeffs_d c = pair_coefficients_d(m, p);
+  return {float(c.q2), float(c.q1), float(c.q0), float(c.qc), float(c.p1)};
+}
+
+pair_coeffs_d pair_coefficients_d(const pair_moments& m, const bayes_params& p) {
   double n0 = m.n0, n1 = m.n1, z = m.mean, m2 = m.m2;
   double n = n0 + n1;
   double q2, q1 = 0, q0 = 0, qc = 0, p1;
@@ -74,7 +79,7 @@ pair_coeffs pair_coefficients(const pair_moments& m, const bayes_params& p) {
       qc = c;
     }
   }
-  return {float(q2), float(q1), float(q0), float(qc), float(p1)};
+  return {q2, q1, q0, qc, p1};
 }
 
 bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, double mu0, double& k, double& h) {

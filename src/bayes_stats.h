@@ -79,10 +79,22 @@ struct pair_coeffs {
   float q2, q1, q0, qc;  // the quadratic's coefficients (see above)
   float p1;              // posterior mean of 1 - p0 under Beta(a0, b0) (plug-in n1 / n for the naive ablation)
 };
+// The same in double (a fold whose float coefficients overflow: see fold_weight).
+struct pair_coeffs_d {
+  double q2, q1, q0, qc, p1;
+};
 // What sampling reads of one pair: the coefficients with the (hierarchical) p1 folded in.
 struct pair_weight {
   float w2, w1, w0, wc;
 };
+struct pair_weight_d {
+  double w2, w1, w0, wc;
+};
+// The largest weight, control-variate weight or mean a pair keeps: a cluster's sums over up to 1024 members stay
+// finite in float. Only absurd radiance scales reach it (the float coefficients overflow from z of about 1.8e19).
+constexpr double max_pair_weight = 1e35;
+// The least weight of a pair that can reach its region (float's least normal number).
+constexpr double min_pair_weight = 0x1p-126;
 
 // Region-prior mode (bayes_params::region_prior): observations are recorded as z = (Y / s) d^2 with s = albedo / pi
 // of the shading point (an irradiance times d^2, free of the surface's albedo), mu0 is fixed per pair when its region
@@ -129,6 +141,8 @@ bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, doubl
 void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p);
 // The coefficients of a pair's posterior (without the hierarchy) from its statistics, rounded to float.
 pair_coeffs pair_coefficients(const pair_moments& m, const bayes_params& p);
+// The same before rounding.
+pair_coeffs_d pair_coefficients_d(const pair_moments& m, const bayes_params& p);
 // Scales all statistics by gamma (animation: the prior regains weight); weights are refolded by the caller.
 void decay_stats(bayes_stats& s, double gamma);
 
@@ -168,7 +182,8 @@ inline pair_weight folded_coeffs(const bayes_stats& s, size_t i, double p1, cons
   return {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
 }
 // Folds pair i's p1 (and, under the mean hierarchy, its parent's mean) into its sampling weight.
-inline double eval_weight(const pair_weight& h, const bayes_params& p, double v, double g);
+template <class H>
+inline double eval_weight(const H& h, const bayes_params& p, double v, double g);
 inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
   double p1 = pair_p1(s, i, up, p);
   if (up >= 0) s.p1_folded[i] = float(p1);  // a child: the p1 its weight now holds (see bayes_sampler::refold)
@@ -179,18 +194,32 @@ inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p)
   }
   // With v = mu0 g the weight is g times its value at g = 1 (see pair_coeffs): W = eval_weight(v = mu0, g = 1).
   double mu0 = prior_mean(s, i, up, p);
-  s.w[i] = float(eval_weight(pw, p, mu0, 1.0));
+  double W = eval_weight(pw, p, mu0, 1.0);
+  if (!(W <= max_pair_weight)) {
+    // Squares of z beyond float's range: the weight from the coefficients in double, at most max_pair_weight (a
+    // weight that is not finite would make every member of its cluster unchoosable).
+    pair_coeffs_d c = pair_coefficients_d(s.m[i], p);
+    W = eval_weight(pair_weight_d{p1 * c.q2, p1 * c.q1, p1 * c.q0, p1 * c.qc}, p, mu0, 1.0);
+    if (!(W <= max_pair_weight)) W = max_pair_weight;
+  }
+  // A pair that can reach its region keeps a positive weight: the naive ablation's plug-in p1 is 0 after zero
+  // samples only, and inside a cluster nothing else would keep such a member choosable.
+  if (mu0 > 0 && W < min_pair_weight) W = min_pair_weight;
+  s.w[i] = float(W);
   if (!p.control_variate) return;
   double k, h;
   // Only for clusters the region nearly always sees: where visibility is mixed it is usually a function of
   // position (a shadow edge through the region), and a region-wide mean would add, not remove, variance.
-  if (!p.second_moment || p1 < p.cv_min_visible || !pair_posterior(s, i, p, mu0, k, h)) {
-    s.w_cv[i] = s.w[i];  // no learned mean (or the mean-only ablation): the plain weight, no control variate
+  bool cv = p.second_moment && p1 >= p.cv_min_visible && pair_posterior(s, i, p, mu0, k, h);
+  // Residual second moment E[(Z - c)^2] with c = p1 k: p1 (k^2 + h) - p1^2 k^2 = p1 h + p1 (1 - p1) k^2.
+  double w_cv = cv ? std::sqrt(p1 * h + p1 * (1 - p1) * k * k) : 0.0;
+  if (!cv || !(w_cv <= max_pair_weight && p1 * k <= max_pair_weight)) {
+    s.w_cv[i] = s.w[i];  // no learned mean (or the mean-only ablation, or one beyond float): no control variate
     s.cv[i] = 0;
     return;
   }
-  // Residual second moment E[(Z - c)^2] with c = p1 k: p1 (k^2 + h) - p1^2 k^2 = p1 h + p1 (1 - p1) k^2.
-  s.w_cv[i] = float(std::sqrt(p1 * h + p1 * (1 - p1) * k * k));
+  if (mu0 > 0 && w_cv < min_pair_weight) w_cv = min_pair_weight;  // (the naive ablation's is 0 after one sample)
+  s.w_cv[i] = float(w_cv);
   s.cv[i] = float(p1 * k);
 }
 // Whether pair i's statistics and what sampling reads of it (its weight columns where the mode keeps them) are finite.
@@ -208,7 +237,8 @@ inline bool pair_state_finite(const bayes_stats& s, size_t i) {
 // that ends learning between passes.
 void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p);
 // Weight of a pair for a point with prior mean v (= scale * bound) and g = 1 / d^2; 0 when v is 0.
-inline double eval_weight(const pair_weight& h, const bayes_params& p, double v, double g) {
+template <class H>
+inline double eval_weight(const H& h, const bayes_params& p, double v, double g) {
   if (!(v > 0)) return 0;
   if (!p.second_moment) return double(h.w2) * v + double(h.w1) * g;
   double val = (double(h.w2) * v + double(h.w1) * g) * v + double(h.w0) * g * g;

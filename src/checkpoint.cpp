@@ -270,8 +270,9 @@ void read_sampler(reader& r, light_sampler& ls) {
         !(b->window_samples >= 0) || std::isnan(b->window_var) || std::isnan(b->window_delta) ||
         (!b->px_prev.empty() && b->px_prev.size() != checked))
       r.fail("fallback check");
-    b->px_var.assign(size_t(checked), 0.0f);
-    b->px_delta.assign(size_t(checked), 0.0f);
+    b->px_var.assign(size_t(checked), 0.0);
+    b->px_delta.assign(size_t(checked), 0.0);
+    b->px_cur.assign(b->px_prev.size(), NAN);
     // Prior means and coefficients are functions of the regions and statistics: recomputed (bit for bit the same);
     // then the saved weights replace the recomputed ones.
     b->rebuild_posterior();

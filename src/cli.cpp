@@ -391,10 +391,11 @@ void add_render_options(CLI::App* r, render_options& o) {
                        "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method)")->group(bg);
   r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the prior-only (bound) PMF, in [0, 1] (default 0)")
       ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
-  r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (> 0, default 0.3)")
-      ->check(positive_number)->group(bg);
-  r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (> 0, default 0.03)")
-      ->check(positive_number)->group(bg);
+  // (At most 1e6 apart from the counts: the posterior mean of 1 - p0 stays far above float's least number.)
+  r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (1e-6 to 1e6, default 0.3)")
+      ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
+  r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (1e-6 to 1e6, default 0.03)")
+      ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
   r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (> 0, default 1)")
       ->check(positive_number)->group(bg);
   r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1, default 2)")

@@ -300,7 +300,8 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   restored.height = params.height;
   if (params.restore) params.restore(restored, sampler);
   bool resuming = !restored.film.empty();
-  if (auto* b = std::get_if<bayes_sampler>(&sampler); b && params.sampler.bayes.oracle_spp > 0 && !resuming) {
+  // (A resumed render's model was frozen by its oracle unless the oracle itself was interrupted: see below.)
+  if (auto* b = std::get_if<bayes_sampler>(&sampler); b && params.sampler.bayes.oracle_spp > 0 && !b->frozen) {
     // Oracle mode: learn for oracle_spp spp on random streams independent of the render's (its own seed),
     // then freeze. Using the render's own streams would let a sample's pmf depend on its own outcome.
     render_inputs learn_in = in;
@@ -312,7 +313,11 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     lp.progress = false;
     render_result scratch;
     render_with(learn_in, *b, lp, scratch);
-    b->frozen = true;
+    if (scratch.interrupted)
+      // Cut short: nothing of it is kept, so a checkpoint saves an empty model and a resumed render learns it anew.
+      sampler = make_light_sampler(params.sampler, in, tree);
+    else
+      b->frozen = true;
   }
   double setup = seconds_since(t0);
   for (int frame = 0; frame < frames; frame++) {

@@ -133,6 +133,9 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --bayes-epsilon nan", "--bayes-epsilon"},
       {"render " + s.json + " --bayes-c nan", "--bayes-c"},
       {"render " + s.json + " --bayes-a0 inf", "--bayes-a0"},
+      // Pseudo-counts so small that the posterior mean of 1 - p0 rounds to 0 in float would starve clusters.
+      {"render " + s.json + " --bayes-b0 1e-300", "--bayes-b0"},
+      {"render " + s.json + " --bayes-a0 1e-7", "--bayes-a0"},
       {"render " + s.json + " --bayes-alpha0 nan", "--bayes-alpha0"},
       {"render " + s.json + " --frame-decay nan", "--frame-decay"},
       {"render " + s.json + " --checkpoint-every nan", "--checkpoint-every"},

@@ -31,7 +31,7 @@ bayes_sampler two_light_sampler(double ratio, double window = 1, bool stratified
 std::vector<double> grey_film(size_t pixels, double v) { return std::vector<double>(3 * pixels, v); }
 
 // Ends a pass whose pixels had the given variance and delta sums (the check's columns, written directly).
-void end_pass(bayes_sampler& s, const std::vector<float>& var, const std::vector<float>& delta,
+void end_pass(bayes_sampler& s, const std::vector<double>& var, const std::vector<double>& delta,
               const std::vector<double>& film, int pass_spp, int spp) {
   std::vector<bayes_row> rows(1);
   s.px_var = var;
@@ -88,6 +88,13 @@ TEST_CASE("the fallback check sums what its definitions say", "[fallback]") {
   t.flush_check(row);  // what check_fallback does for the row's last pixel
   CHECK(t.px_var[0] == Approx(0.5f * 4.0f));
   CHECK(t.px_var[1] == 0.0f);
+  // Until the pass is complete, the samples it pairs with stay (an interrupted pass must not change what a
+  // checkpoint saves); check_fallback then keeps this pass's samples for the next.
+  CHECK(t.px_prev[0] == 2.0f);
+  CHECK(t.px_prev[1] == 1.0f);
+  t.check_fallback(rows, film, 1.0, 1, 3);
+  CHECK(t.px_prev[0] == 4.0f);
+  CHECK(t.px_prev[1] == 1.0f);
 }
 
 TEST_CASE("the fallback decision needs two check windows in a row below the threshold", "[fallback]") {

@@ -4,6 +4,7 @@
 // sampled or learned); non-adaptive and frozen samplers keep equal weights bit for bit; and on a scene where the
 // prior is poor (a bright lamp shut in a box beside a dim one) weighting lowers the error, paired over seeds.
 #include "bvh.h"
+#include "light_sampler.h"
 #include "lights.h"
 #include "render.h"
 #include "scene.h"
@@ -12,6 +13,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <csignal>
 #include <memory>
 
 using namespace bl;
@@ -123,6 +125,39 @@ TEST_CASE("non-adaptive and frozen samplers keep equal weights bit for bit", "[p
   render_result w = render(b->scene, b->bvh, b->lights, p4);
   CHECK(w.film_weight == 12.0);
   CHECK(w.film == a.film);
+}
+
+TEST_CASE("an oracle interrupted while it learns leaves no frozen model behind", "[passes]") {
+  // What a checkpoint saves on the way out of an interrupted oracle: an empty model, not frozen, so that a resumed
+  // render learns the oracle's model anew (a half-learned frozen one would give other bytes than a render never
+  // interrupted).
+  auto b = boxed_lamp_scene();
+  render_params p = small_params(sampler_kind::bayes, 4, 4);
+  p.sampler.bayes.oracle_spp = 16;
+  bool saved = false, frozen = true;
+  double observations = -1;
+  p.on_pass = [&](const render_result&, const light_sampler& ls, bool last) {
+    if (!last) return;
+    const bayes_sampler& s = std::get<bayes_sampler>(ls);
+    saved = true;
+    frozen = s.frozen;
+    observations = 0;
+    for (const pair_moments& m : s.stats.m) observations += m.n0 + m.n1;
+  };
+  install_interrupt_handlers();
+  std::raise(SIGINT);  // the handler only notes it: the oracle's first pass stops, and so does the render
+  render_result r = render(b->scene, b->bvh, b->lights, p);
+  reset_interrupt();
+  CHECK(r.interrupted);
+  CHECK(r.spp == 0);
+  REQUIRE(saved);
+  CHECK(!frozen);
+  CHECK(observations == 0);
+  // Uninterrupted, the oracle learns and freezes.
+  render_result full = render(b->scene, b->bvh, b->lights, p);
+  CHECK(full.spp == 4);
+  CHECK(frozen);
+  CHECK(observations > 0);
 }
 
 TEST_CASE("weighting the first passes lowers bayes's error where the prior is poor", "[passes]") {
