@@ -231,13 +231,22 @@ int run_render(const render_options& o) {
                           " spp already in " + o.resume);
     };
   auto last_write = std::chrono::steady_clock::now();
+  // A checkpoint that cannot be written (a full disk) is reported and the render goes on: its image is still
+  // written, and the exit status is 1 at the end.
+  std::string checkpoint_failure;
   params.on_pass = [&](const render_result& r, const light_sampler& s, bool last) {
     if (!last && o.stop_after_passes > 0 && r.passes == o.stop_after_passes) std::raise(SIGINT);
     if (o.checkpoint.empty()) return;
     auto now = std::chrono::steady_clock::now();
     bool due = std::chrono::duration<double>(now - last_write).count() >= o.checkpoint_every;
     if (!last && !due && r.passes != o.kill_after_passes) return;
-    write_file_atomic(o.checkpoint, encode_checkpoint(fingerprint, r, s));
+    try {
+      write_file_atomic(o.checkpoint, encode_checkpoint(fingerprint, r, s));
+    } catch (const output_error& e) {
+      if (checkpoint_failure.empty())
+        std::fprintf(stderr, "bayeslight: warning: %s; the render goes on without it\n", e.what());
+      checkpoint_failure = e.what();
+    }
     last_write = now;
     if (!last && o.kill_after_passes > 0 && r.passes == o.kill_after_passes) std::raise(SIGKILL);
   };
@@ -262,6 +271,7 @@ int run_render(const render_options& o) {
     int sig = interrupt_signal();
     return 128 + (sig != 0 ? sig : SIGINT);
   }
+  if (!checkpoint_failure.empty()) throw output_error(checkpoint_failure);  // (the image is written)
   return exit_ok;
 }
 

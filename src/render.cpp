@@ -178,7 +178,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
       result.interrupted = true;
       break;
     }
-    int count = std::min(pass_size(pass, done), target - done);
+    int count = std::min(pass_size(pass, done, int64_t(in.camera.width) * in.camera.height), target - done);
     progress.pass = pass + 1;
     progress.pass_spp = count;
     progress.rows_done = 0;
@@ -246,13 +246,16 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
 
 }  // namespace
 
-int pass_size(int pass, int done) {
+int pass_size(int pass, int done, int64_t pixels) {
   // 1 spp per pass while learning matters most, then passes of 1/4 of the samples so far (the error log gets
   // log-spaced points; learning costs a few per cent of the render: 15 passes for 32 spp, 19 for 64), at most
   // 64 spp. Passes of 1/8 (23 passes for 32 spp) learned no better: fixed-spp relMSE within 0.5 % on the living
   // room, plant room and hall (32 and 128 spp, two seeds), at about 1.5x the learning time.
+  // Images under 1024 pixels may grow passes to 65536 samples: every pass keeps a record (the log, checkpoints),
+  // and a 1-pixel render of 2^31 spp in 64-spp passes held 3 GB of them.
   if (pass < 8) return 1;
-  return std::min(64, std::max(1, done / 4));
+  int cap = int(std::max<int64_t>(64, (int64_t(1) << 16) / std::max<int64_t>(pixels, 1)));
+  return std::min(cap, std::max(1, done / 4));
 }
 
 bool sampler_adapts(const light_sampler& s) {

@@ -79,8 +79,9 @@ struct render_result {
   std::vector<pass_record> log;
 };
 
-// Samples per pixel of pass `pass` given `done` samples before it (before truncation to the target).
-int pass_size(int pass, int done);
+// Samples per pixel of pass `pass` given `done` samples before it (before truncation to the target), for an image
+// of `pixels` pixels.
+int pass_size(int pass, int done, int64_t pixels);
 // Weight of the samples of a pass that starts after `done` spp: (done + 1) / (done + 1 + s), 1 for s = 0.
 double pass_weight(int done, double s);
 // Whether the sampler's passes are weighted by pass_weight (an adaptive sampler that still learns).

@@ -201,6 +201,22 @@ TEST_CASE("a log that cannot be written at write time exits 1 after writing the 
   CHECK(s.temporaries().empty());
 }
 
+TEST_CASE("a checkpoint that cannot be written is reported, and the render and its image go on", "[faults]") {
+  fault_scene s;
+  const std::string ck = s.dir / "ck.bin";
+  REQUIRE(::symlink("/dev/full", ck.c_str()) == 0);
+  // Every pass's checkpoint (--checkpoint-every 0) and the last one fail; the image is that of a render without.
+  auto r = run_bayeslight("render " + s.json + " --sampler bayes --quiet -o " + (s.dir / "img.pfm") + " --checkpoint " +
+                          ck + " --checkpoint-every 0");
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(contains(r.output, "warning: cannot write " + ck));
+  CHECK(contains(r.output, "No space left on device"));
+  REQUIRE(run_bayeslight("render " + s.json + " --sampler bayes --quiet -o " + (s.dir / "plain.pfm")).status == 0);
+  CHECK(read_file(s.dir / "img.pfm") == read_file(s.dir / "plain.pfm"));
+  CHECK(s.temporaries().empty());
+}
+
 TEST_CASE("a write that fails midway never clobbers the existing output", "[faults]") {
   fault_scene s;
   const std::string out = s.dir / "out.pfm", png = s.dir / "out.png", log = s.dir / "log.csv";

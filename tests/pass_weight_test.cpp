@@ -127,6 +127,22 @@ TEST_CASE("non-adaptive and frozen samplers keep equal weights bit for bit", "[p
   CHECK(w.film == a.film);
 }
 
+TEST_CASE("passes of a tiny image grow to 65536 samples, so their records stay few", "[passes]") {
+  // Every pass keeps a record (log, checkpoint): a 1-pixel image in 64-spp passes held 3 GB of them at 2^31 spp.
+  CHECK(pass_size(3, 2, 1) == 1);  // the first 8 passes: 1 spp
+  CHECK(pass_size(20, 1 << 20, 1) == 65536);
+  CHECK(pass_size(20, 1 << 20, 16) == 4096);
+  CHECK(pass_size(20, 1 << 20, 1024) == 64);  // 1024 pixels and more: the 64-spp passes
+  CHECK(pass_size(20, 1 << 20, 640 * 480) == 64);
+  CHECK(pass_size(20, 100, 1) == 25);  // a quarter of the samples so far
+  auto b = boxed_lamp_scene();
+  render_params p = small_params(sampler_kind::uniform, 1 << 20, 0);
+  p.width = p.height = 1;
+  render_result r = render(b->scene, b->bvh, b->lights, p);
+  CHECK(r.spp == 1 << 20);
+  CHECK(r.passes < 80);  // about 67 (16,400 in 64-spp passes)
+}
+
 TEST_CASE("an oracle interrupted while it learns leaves no frozen model behind", "[passes]") {
   // What a checkpoint saves on the way out of an interrupted oracle: an empty model, not frozen, so that a resumed
   // render learns the oracle's model anew (a half-learned frozen one would give other bytes than a render never
