@@ -36,7 +36,8 @@ light_data build_lights(const scene_data& scene) {
     l.sun_radiance = scene.sun.irradiance / (pi_f * sin2);
     // Power of a distant light: its irradiance over the disk that bounds the scene (as pbrt does).
     float r = 0.5f * diagonal(scene.bounds);
-    l.power.push_back(luminance(scene.sun.irradiance) * pi_f * r * r);
+    // (At most 1e30, the emitters' limit (obj_io.cpp): an infinite power would leave nothing else sampled.)
+    l.power.push_back(std::min(luminance(scene.sun.irradiance) * pi_f * r * r, 1e30f));
   }
   return l;
 }

@@ -15,6 +15,7 @@
 #include <array>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -190,6 +191,39 @@ static std::vector<size_t> compact_refs(std::vector<int>& refs, size_t count) {
   return kept;
 }
 
+// Emitted power (luminance of Ke times area times pi) above which light sums and importances could overflow float.
+constexpr double max_emitted_power = 1e30;
+
+// Refuses emitters whose power, one by one or all together, is beyond max_emitted_power: light selection sums
+// powers and intensities in float, and an infinite one would leave every light but the one seen directly unsampled.
+static void check_emitted_power(const std::string& path, const obj_clean_data& clean, const mesh_data& mesh) {
+  double total = 0;
+  for (size_t t = 0; t < mesh.tri_materials.size(); t++) {
+    int k = mesh.tri_materials[t];
+    if (k < 0 || size_t(k) >= clean.materials.size()) continue;  // the default material emits nothing
+    const mtl_material_data& m = clean.materials[size_t(k)];
+    double le = luminance(m.material.ke);
+    if (!(le > 0)) continue;
+    vec3f p[3];
+    for (int c = 0; c < 3; c++) p[c] = mesh.positions[size_t(mesh.tri_positions[3 * t + size_t(c)])];
+    double e1[3] = {double(p[1].x) - p[0].x, double(p[1].y) - p[0].y, double(p[1].z) - p[0].z};
+    double e2[3] = {double(p[2].x) - p[0].x, double(p[2].y) - p[0].y, double(p[2].z) - p[0].z};
+    double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
+    double power = le * 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz) * M_PI;
+    total += power;
+    if (power > max_emitted_power || total > max_emitted_power) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.3g", power > max_emitted_power ? power : total);
+      throw input_error(m.mtl_path.empty() ? path : m.mtl_path, m.mtl_path.empty() ? 0 : m.line,
+                        "material \"" + m.material.name + "\": " +
+                            (power > max_emitted_power ? "Ke makes a triangle of " + path + " emit a power of "
+                                                       : "with it the emitters of " + path + " emit a power of ") +
+                            buf + " (luminance x area x pi), above 1e30, beyond what light selection sums in float; "
+                            "scale Ke or the scene down");
+    }
+  }
+}
+
 // What tinyobjloader parsed from the clean text.
 struct tinyobj_result {
   tinyobj::attrib_t attrib;
@@ -339,6 +373,7 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   for (size_t i : compact_refs(mesh.tri_normals, normals.size())) mesh.normals.push_back(normals[i]);
   for (size_t i : compact_refs(mesh.tri_texcoords, clean.texcoords.size()))
     mesh.texcoords.push_back(clean.texcoords[i]);
+  check_emitted_power(path, clean, mesh);
 
   // Materials in order of first usemtl, then the default one if some face had none; textures once per path.
   std::map<std::string, int> loaded;

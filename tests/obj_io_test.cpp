@@ -413,6 +413,28 @@ TEST_CASE("material library errors name the MTL file and line", "[obj]") {
   CHECK_THAT(load_error(obj_for("newmtl\n")), Catch::Contains(mtl + ":1: newmtl needs a material name"));
 }
 
+TEST_CASE("emitters whose power would overflow light selection's float sums are input errors", "[obj]") {
+  // Power = luminance(Ke) x area x pi, refused above 1e30 per triangle or for all emitters together; the message
+  // names the material's newmtl line.
+  temp_dir dir;
+  const std::string mtl = dir.path + "/lib.mtl";
+  auto obj_for = [&](const std::string& ke, int triangles) {
+    dir.write("lib.mtl", "newmtl a\nKd 0 0 0\nKe " + ke + "\n");
+    std::string obj = "mtllib lib.mtl\nusemtl a\n";
+    for (int i = 0; i < triangles; i++) {  // right triangles of area 0.5, one above the other
+      std::string y = std::to_string(i);
+      obj += "v 0 " + y + " 0\nv 1 " + y + " 0\nv 0 " + y + " 1\nf -3 -2 -1\n";
+    }
+    return dir.write("o.obj", obj);
+  };
+  // 1e30 / (0.5 pi) = 6.4e29: a luminance of 1e30 is too much for one triangle, 4e29 for two, 3e29 for neither.
+  CHECK_THAT(load_error(obj_for("1e30 1e30 1e30", 1)), Catch::Contains(mtl + ":1: material \"a\": Ke makes a triangle"));
+  CHECK_THAT(load_error(obj_for("1e30 1e30 1e30", 1)), Catch::Contains("power of 1.57e+30"));
+  CHECK_THAT(load_error(obj_for("4e29 4e29 4e29", 2)), Catch::Contains(mtl + ":1: material \"a\": with it the emitters"));
+  CHECK(load_obj(obj_for("3e29 3e29 3e29", 2)).tri_materials.size() == 2);
+  CHECK(load_obj(obj_for("3e29 3e29 3e29", 1)).tri_materials.size() == 1);
+}
+
 TEST_CASE("a missing MTL is an input error at its OBJ line; an undefined material gets the default", "[obj]") {
   temp_dir dir;
   auto obj = dir.write("a.obj", std::string(square_vertices) + "mtllib missing.mtl\nf 1 2 3\n");
