@@ -206,10 +206,8 @@ static void check_emitted_power(const std::string& path, const obj_clean_data& c
     if (!(le > 0)) continue;
     vec3f p[3];
     for (int c = 0; c < 3; c++) p[c] = mesh.positions[size_t(mesh.tri_positions[3 * t + size_t(c)])];
-    double e1[3] = {double(p[1].x) - p[0].x, double(p[1].y) - p[0].y, double(p[1].z) - p[0].z};
-    double e2[3] = {double(p[2].x) - p[0].x, double(p[2].y) - p[0].y, double(p[2].z) - p[0].z};
-    double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
-    double power = le * 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz) * M_PI;
+    // (The squared length of the cross product is finite: good_triangle kept only such triangles.)
+    double power = le * 0.5 * std::sqrt(double(length_sq(cross(p[1] - p[0], p[2] - p[0])))) * M_PI;
     total += power;
     if (power > max_emitted_power || total > max_emitted_power) {
       char buf[64];
