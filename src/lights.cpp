@@ -25,12 +25,7 @@ light_data build_lights(const scene_data& scene) {
     l.sun = l.count++;
     l.sun_dir = normalize(scene.sun.direction);
     l.sun_frame = make_frame(l.sun_dir);
-    // A smaller disk than a half-angle of 1e-6 rad (0.2 arc seconds) is drawn at that size: its irradiance is the
-    // same, and its radiance and pdf stay in float's range (a diameter of 1e-18 degrees would overflow both).
-    constexpr float min_sun_half_angle = 1e-6f;
-    float half = std::max(0.5f * scene.sun.angular_diameter_deg * pi_f / 180.0f, min_sun_half_angle);
-    float s = std::sin(0.5f * half);
-    l.sun_one_minus_cos = 2 * s * s;  // 1 - cos(half) without cancellation
+    l.sun_one_minus_cos = sun_one_minus_cos(scene.sun.angular_diameter_deg);
     float sin2 = l.sun_one_minus_cos * (2 - l.sun_one_minus_cos);
     l.sun_irradiance = scene.sun.irradiance;
     l.sun_radiance = scene.sun.irradiance / (pi_f * sin2);

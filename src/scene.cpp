@@ -4,6 +4,8 @@
 #include "errors.h"
 #include "texture.h"
 
+#include <cstdio>
+
 namespace bl {
 
 scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_params& sun, bool two_sided,
@@ -51,7 +53,18 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
 
 scene_data build_scene(const scene_desc& desc, float aspect) {
   scene_data s = build_scene(load_obj(desc.mesh_path), desc.camera, desc.sun, desc.two_sided_emitters, aspect);
-  // A camera completed from the mesh bounds (scene_desc.h) can only be checked now.
+  // A camera completed from the mesh bounds (scene_desc.h) can only be checked now. Embree refuses ray origins beyond
+  // about 1.8e18; the framing distance grows with the scene's extent and as 1 / sin of half the field of view.
+  for (const vec3f* v : {&s.camera.eye, &s.camera.target})
+    if (!(max_abs_component(*v) <= 1e17f)) {
+      char where[96];
+      std::snprintf(where, sizeof where, "(%.3g, %.3g, %.3g)", double(v->x), double(v->y), double(v->z));
+      throw input_error(desc.path, std::string("the camera framed from the mesh bounds would have its ") +
+                                       (v == &s.camera.eye ? "eye" : "target") + " at " + where +
+                                       ", beyond 1e17 of the origin (the scene's extent, or a tiny \"fov_y_deg\"): "
+                                       "give the camera's \"eye\" and \"target\" in a scene file, or a wider "
+                                       "\"fov_y_deg\"");
+    }
   vec3f dir = s.camera.target - s.camera.eye;
   if (!(length(normalize(dir)) > 0))
     throw input_error(desc.path, "the camera's \"eye\" is the mesh's centre, its default \"target\": give a target");

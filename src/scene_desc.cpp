@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -146,6 +147,15 @@ void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
     sun.angular_diameter_deg = get_number(ctx, j["angular_diameter_deg"], "angular_diameter_deg");
   if (!(sun.angular_diameter_deg > 0 && sun.angular_diameter_deg < 90))
     ctx.fail("angular_diameter_deg", "sun \"angular_diameter_deg\" must be in (0, 90)");
+  // The disk's radiance (irradiance over its projected solid angle) must stay far inside float's range.
+  double omc = sun_one_minus_cos(sun.angular_diameter_deg);
+  double radiance = double(max_component(sun.irradiance)) / (M_PI * omc * (2 - omc));
+  if (!(radiance <= 1e35)) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "sun \"irradiance\" over a disk of %g degrees is a radiance of %.3g, above 1e35",
+                  double(sun.angular_diameter_deg), radiance);
+    ctx.fail("irradiance", std::string(buf) + ": lower the irradiance or widen the disk");
+  }
 }
 
 std::string lower_extension(const std::string& path) {
@@ -276,6 +286,13 @@ vec3f animated_sun_direction(const sun_params& sun, int frame, int frames) {
     d = a * std::cos(t * angle) + perp * std::sin(t * angle);
   }
   return normalize(d);
+}
+
+float sun_one_minus_cos(float angular_diameter_deg) {
+  constexpr float min_half_angle = 1e-6f;
+  float half = std::max(0.5f * angular_diameter_deg * pi_f / 180.0f, min_half_angle);
+  float s = std::sin(0.5f * half);
+  return 2 * s * s;  // 1 - cos(half) without cancellation
 }
 
 camera_params frame_bounds(const bbox3f& bounds, float fov_y_deg, float aspect) {

@@ -30,6 +30,10 @@ struct sun_params {
   vec3f irradiance = {0, 0, 0};
   float angular_diameter_deg = 0.53f;
 };
+// 1 - cos of the half-angle of a sun disk of this diameter, without cancellation. A disk smaller than a half-angle of
+// 1e-6 rad (0.2 arc seconds) is drawn at that size: its irradiance is the same, and its radiance and pdf stay in
+// float's range (a diameter of 1e-18 degrees would overflow both).
+float sun_one_minus_cos(float angular_diameter_deg);
 
 // Everything a scene file says.
 struct scene_desc {

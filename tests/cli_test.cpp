@@ -201,6 +201,16 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
        "far_target.json:1: camera \"target\" must lie within 1e17"},
       {"huge_image.json", "{\"mesh\": \"box.obj\", \"image\": {\"width\": 65536, \"height\": 65536}}",
        "huge_image.json: image of 65536x65536 pixels is too large"},
+      // A camera framed from the bounds with a tiny field of view (or around a mesh spanning 1e19) would stand
+      // beyond Embree's range: Embree aborted.
+      {"tiny_fov.json", "{\"mesh\": \"box.obj\", \"camera\": {\"fov_y_deg\": 1e-20}}",
+       "tiny_fov.json: the camera framed from the mesh bounds would have its eye at (0, 0.5, 1.72e+22)"},
+      {"far.obj", "v 0 0 0\nv 1e-20 0 0\nv 0 1e19 0\nf 1 2 3\n", "far.obj: the camera framed from the mesh bounds"},
+      // A small disk of a strong sun: a radiance beyond float (the image was black).
+      {"hot_sun.json",
+       "{\"mesh\": \"box.obj\", \"sun\": {\"direction\": [0,1,0], \"irradiance\": [1e30,1,1], "
+       "\"angular_diameter_deg\": 1e-5}}",
+       "hot_sun.json:1: sun \"irradiance\" over a disk of 1e-05 degrees is a radiance of 3.18e+41, above 1e35"},
   };
   write_text(s.dir / "bad.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n");
   for (const auto& c : cases) {
