@@ -270,12 +270,13 @@ static tinyobj_result parse_clean(const std::string& path, const obj_clean_data&
 // BSDF-sampled estimates of that light would disagree. Returns how many were dropped. Keeps file order.
 static int drop_repeated_emitters(mesh_data& mesh, const std::vector<vec3f>& pos, const std::vector<char>& emissive) {
   size_t n = mesh.tri_materials.size();
-  // Each emissive triangle's corners as 9 float bit patterns, rotated to start at its smallest corner.
+  // Each emissive triangle's corners as 9 float bit patterns, rotated to start at its smallest corner (-0 written
+  // as 0: the same point, other bits).
   auto key = [&](size_t t) {
     std::array<uint32_t, 9> k{};
     std::array<std::array<uint32_t, 3>, 3> c{};
     for (int i = 0; i < 3; i++) {
-      vec3f p = pos[size_t(mesh.tri_positions[3 * t + size_t(i)])];
+      vec3f p = pos[size_t(mesh.tri_positions[3 * t + size_t(i)])] + vec3f{0, 0, 0};  // (-0 + 0 = +0)
       std::memcpy(c[size_t(i)].data(), &p, sizeof p);
     }
     int r = 0;

@@ -65,13 +65,29 @@ static long long be32(const std::string& b, size_t off) {
   return v;
 }
 
-// Smallest file that can hold the pixels of an uncompressed TGA or BMP of w x h texels (0 for other formats):
-// stb_image reads zeros past the end of these, so a truncated file would otherwise decode without error.
+// Smallest file that can hold the pixels of an uncompressed or run-length encoded TGA, or an uncompressed BMP, of
+// w x h texels (0 for other formats): stb_image reads zeros past the end of these, so a truncated file would
+// otherwise decode without error (as black).
 static long long uncompressed_size(const std::string& b, long long w, long long h) {
   if (b.size() >= 18 && b.compare(0, 2, "BM") != 0) {  // TGA (only .tga files without PNG/JPEG magic get here)
     long long type = (unsigned char)b[2], bytes_pp = ((unsigned char)b[16] + 7) / 8;
     long long palette = b[1] ? le(b, 5, 2) * (((unsigned char)b[7] + 7) / 8) : 0;
-    if (type >= 1 && type <= 3) return 18 + (unsigned char)b[0] + palette + w * h * bytes_pp;
+    long long data = 18 + (unsigned char)b[0] + palette;
+    if (type >= 1 && type <= 3) return data + w * h * bytes_pp;
+    if (type >= 9 && type <= 11) {
+      // Packets: a header byte, then one pixel repeated (high bit set) or (header & 127) + 1 raw pixels; each
+      // covers (header & 127) + 1 pixels. Walked until they cover the image or the file ends (then one byte more
+      // than the file: truncated). At most one step per byte of the file.
+      long long off = data, covered = 0, size = (long long)b.size();
+      while (covered < w * h) {
+        if (off >= size) return size + 1;
+        unsigned header = (unsigned char)b[size_t(off)];
+        long long count = (header & 127) + 1;
+        off += 1 + (header & 128 ? 1 : count) * std::max(bytes_pp, 1LL);
+        covered += count;
+      }
+      return off;
+    }
   } else if (b.size() >= 30 && b.compare(0, 2, "BM") == 0) {
     long long header = le(b, 14, 4), bpp = header == 12 ? le(b, 24, 2) : le(b, 28, 2);
     long long compression = header >= 40 ? le(b, 30, 4) : 0;

@@ -208,7 +208,9 @@ TEST_CASE("an emissive triangle repeating an earlier one is dropped, other repea
   dir.write("m.mtl", "newmtl lamp\nKe 5 5 5\nnewmtl wall\nKd 0.5 0.5 0.5\n");
   auto obj = dir.write("m.obj", "mtllib m.mtl\n" + std::string(square_vertices) +
                                     "v 0 0 0\n"  // a second vertex at corner 1's place: repeats by position count
+                                    "v -0 0 -0\n"  // and a third, written with negative zeros
                                     "usemtl lamp\nf 1 2 3\nf 2 3 1\nf 5 2 3\nf 3 2 1\n"  // same, rotated, copy, reversed
+                                    "f 6 2 3\n"
                                     "usemtl wall\nf 1 2 3\nf 1 2 3\n");                  // non-emissive repeats
   mesh_data m = load_obj(obj);
   check_invariants(m);

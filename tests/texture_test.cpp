@@ -217,6 +217,21 @@ TEST_CASE("truncated TGA and BMP files and impossible sizes are input errors", "
   CHECK(texel_rgb(t, 0).x == srgb8_to_linear(0x30));
   write_bytes(dir.file("cut.tga"), tga.substr(0, 21));
   CHECK_THAT(texture_error(dir.file("cut.tga")), Catch::Contains("cut.tga: cannot decode image: truncated"));
+  // Run-length encoded 4x1 (type 10): a run of 3 of one texel, then one raw texel. Whole, then cut inside its
+  // packets and to its header: stb_image alone loaded those as black.
+  const unsigned char rle_bytes[26] = {0, 0, 10, 0, 0, 0, 0, 0, 0, 0, 0, 0, 4, 0, 1, 0, 24, 0x20,
+                                       0x82, 0x10, 0x20, 0x30, 0x00, 0x40, 0x50, 0x60};
+  std::string rle(reinterpret_cast<const char*>(rle_bytes), sizeof rle_bytes);
+  write_bytes(dir.file("rle.tga"), rle);
+  texture_data r = load_texture(dir.file("rle.tga"));
+  REQUIRE(r.width == 4);
+  CHECK(texel_rgb(r, 2).x == srgb8_to_linear(0x30));
+  CHECK(texel_rgb(r, 3).x == srgb8_to_linear(0x60));
+  for (size_t cut : {25, 22, 18}) {
+    write_bytes(dir.file("rle_cut.tga"), rle.substr(0, cut));
+    INFO(cut << " bytes");
+    CHECK_THAT(texture_error(dir.file("rle_cut.tga")), Catch::Contains("rle_cut.tga: cannot decode image: truncated"));
+  }
   // A BMP written by stb, whole and cut short.
   std::vector<unsigned char> px(8 * 8 * 3, 77);
   REQUIRE(stbi_write_bmp(dir.file("ok.bmp").c_str(), 8, 8, 3, px.data()) != 0);
