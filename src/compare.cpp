@@ -151,10 +151,11 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
     double num = data.equal_time ? base.relmse : base.relmse * base.seconds;
     double den = data.equal_time ? st.relmse : st.relmse * st.seconds;
     st.speedup = den > 0 && std::isfinite(num) && std::isfinite(den) ? num / den : NAN;
-    // The first sampler's own relMSE at the budget is reached at the budget by definition (its curve can rise
-    // again in the pass after it, heavy-tailed as relMSE is).
-    st.time_to_target = data.equal_time && &st == &all[0] ? data.time_budget
-                                                         : time_to_reach(st.curve_seconds, st.curve_relmse, base.relmse);
+    // The first sampler reaches its own relMSE at its end by definition: at the budget at equal time (its curve can
+    // rise again in the pass after it, heavy-tailed as relMSE is), at its mean time at equal spp (where its curve's
+    // last point, the mean of sums, can differ from the sum of means in the last bit and miss it).
+    if (&st == &all[0]) st.time_to_target = data.equal_time ? data.time_budget : st.seconds;
+    else st.time_to_target = time_to_reach(st.curve_seconds, st.curve_relmse, base.relmse);
   }
   return all;
 }
