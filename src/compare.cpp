@@ -93,7 +93,8 @@ double relmse_at_time(const std::vector<pass_record>& log, double t) {
   if (i == log.size()) return log.back().error.relmse;
   if (i == 0) return log[0].error.relmse;
   double t0 = log[i - 1].seconds, t1 = log[i].seconds, e0 = log[i - 1].error.relmse, e1 = log[i].error.relmse;
-  if (!(t0 > 0 && t1 > t0 && e0 > 0 && e1 > 0)) return e1;
+  if (!(t0 > 0 && t1 > t0)) return e1;
+  if (!(e0 > 0 && e1 > 0)) return e0 + (e1 - e0) * (t - t0) / (t1 - t0);  // (an exact pass: no logarithm)
   double f = (std::log(t) - std::log(t0)) / (std::log(t1) - std::log(t0));
   return std::exp(std::log(e0) + f * (std::log(e1) - std::log(e0)));
 }

@@ -414,6 +414,25 @@ TEST_CASE("time to reach a target error interpolates log-log between passes", "[
                                                                                    std::log(2.0) / std::log(0.5))));
 }
 
+TEST_CASE("relMSE at a time interpolates log-log between the passes around it", "[compare]") {
+  auto log_of = [](std::vector<std::pair<double, double>> points) {
+    std::vector<pass_record> log;
+    for (auto [t, e] : points) {
+      pass_record p;
+      p.seconds = t;
+      p.error.relmse = e;
+      log.push_back(p);
+    }
+    return log;
+  };
+  std::vector<pass_record> log = log_of({{1, 1}, {2, 0.5}, {4, 0.25}});
+  CHECK(relmse_at_time(log, 3) == Approx(1 / 3.0).epsilon(1e-12));  // relMSE = 1 / t
+  CHECK(relmse_at_time(log, 0.5) == 1);                            // before the first pass: the first
+  CHECK(relmse_at_time(log, 9) == 0.25);                           // after the last: the last
+  // A pass with no error at all (it matched the reference): linear, not the later pass's value.
+  CHECK(relmse_at_time(log_of({{1, 0}, {3, 0.2}}), 2) == Approx(0.1));
+}
+
 TEST_CASE("at equal spp the first sampler reaches its own mean relMSE at its own mean time", "[compare]") {
   // Three runs of one pass whose mean of sums, (a + b + c) / 3, lies one ulp above the sum of means a/3 + b/3 + c/3:
   // the curve's last point missed the target it defines, and the table showed no time for the baseline.
