@@ -213,6 +213,20 @@ int run_render(const render_options& o) {
   light_data lights = build_lights(scene);
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", o.scene.c_str());
+  if (lights.tri_count > 0) {
+    // Rays leave surfaces by at least ray_epsilon's floor, a share of the scene's largest coordinate (so that points
+    // near the origin on a huge triangle do not hit it again). Past the size of the lights, their light is lost.
+    std::vector<float> sizes;
+    for (int t : lights.tri) sizes.push_back(std::sqrt(scene.tri_area[size_t(t)]));
+    std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
+    float offset = min_ray_epsilon(scene, {0, 0, 0}), median = sizes[sizes.size() / 2];
+    if (offset >= median)
+      std::fprintf(stderr,
+                   "%s: warning: the scene extends to %.3g from the origin, so rays leave surfaces by at least %.3g, "
+                   "more than the size of its lights (median %.3g): their light is lost (the image is too dark); "
+                   "bring far geometry closer\n",
+                   o.scene.c_str(), double(scene.scale), double(offset), double(median));
+  }
   if (!o.quiet) {
     auto t_end = std::chrono::steady_clock::now();
     std::fprintf(stderr, "%s: %zu triangles, %d lights%s; loaded in %.2f s, Embree BVH and lights in %.2f s\n",

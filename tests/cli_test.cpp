@@ -35,6 +35,23 @@ bool exists(const std::string& p) { return std::filesystem::exists(p); }
 
 }  // namespace
 
+TEST_CASE("a scene so large that rays leave surfaces by more than its lights' size is warned about", "[cli]") {
+  // Two tiny triangles 1e8 from the origin stretch the bounds; ray offsets (a share of the largest coordinate) then
+  // exceed the 0.4-unit lamp, whose light is lost (a review found the image black, silently).
+  tiny_scene s;
+  auto plain = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "a.pfm"));
+  REQUIRE(plain.status == 0);
+  CHECK(plain.output.find("warning") == std::string::npos);
+  std::string obj = read_text(s.dir / "box.obj");
+  write_text(s.dir / "box.obj", obj + "usemtl floor\nv 1e8 0 0\nv 1e8 1 0\nv 1e8 0 1\nf -3 -2 -1\n"
+                                      "v -1e8 0 0\nv -1e8 1 0\nv -1e8 0 1\nf -3 -2 -1\n");
+  auto far = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "b.pfm"));
+  INFO(far.output);
+  CHECK(far.status == 0);
+  CHECK(far.output.find("warning: the scene extends to 1e+08 from the origin, so rays leave surfaces by at least 5") !=
+        std::string::npos);
+}
+
 TEST_CASE("a render writes every requested output and a per pass log", "[cli]") {
   tiny_scene s;
   auto r = run_bayeslight("render " + s.json + " --sampler power -o " + (s.dir / "a.exr") + " -o " +
