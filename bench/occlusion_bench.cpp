@@ -59,20 +59,11 @@ ray_batch& batch() {
         int light = std::min(int(v.u[0] * float(r->lights.count)), r->lights.count - 1);
         light_sample ls = sample_light_point(r->lights, r->scene, light, sp.p, v.u[2], v.u[3]);
         if (!(ls.pdf > 0)) continue;
-        vec3f o = offset_ray_origin(r->scene, sp.p, sp.ng, ls.wi);
-        if (ls.dist == inf_f) {
-          r->sh_org.push_back(o);
-          r->sh_dir.push_back(ls.wi);
-          r->sh_tmax.push_back(inf_f);
-          continue;
-        }
-        vec3f target = offset_ray_origin(r->scene, ls.p, ls.n, -ls.wi);
-        vec3f d = target - o;
-        float t = length(d);
-        if (!(t > 0)) continue;
-        r->sh_org.push_back(o);
-        r->sh_dir.push_back(d / t);
-        r->sh_tmax.push_back(t);
+        shadow_ray sr = shadow_ray_of(r->scene, sp, ls);  // the render's own shadow rays
+        if (!(sr.tmax > 0)) continue;
+        r->sh_org.push_back(sr.org);
+        r->sh_dir.push_back(sr.dir);
+        r->sh_tmax.push_back(sr.tmax);
       }
     return r;
   }();

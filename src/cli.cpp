@@ -214,18 +214,21 @@ int run_render(const render_options& o) {
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", o.scene.c_str());
   if (lights.tri_count > 0) {
-    // Rays leave surfaces by at least ray_epsilon's floor, a share of the scene's largest coordinate (so that points
-    // near the origin on a huge triangle do not hit it again). Past the size of the lights, their light is lost.
-    std::vector<float> sizes;
-    for (int t : lights.tri) sizes.push_back(std::sqrt(scene.tri_area[size_t(t)]));
-    std::nth_element(sizes.begin(), sizes.begin() + sizes.size() / 2, sizes.end());
-    float offset = min_ray_epsilon(scene, {0, 0, 0}), median = sizes[sizes.size() / 2];
-    if (offset >= median)
+    // Rays leave a surface by at least 1e-6 of the largest coordinate there (what the hit point's rounding needs). A
+    // light whose size is below that, far from the origin, is stepped over: warn when that holds for the median
+    // light (the offset over the size, per light triangle at its centroid).
+    std::vector<float> ratio;
+    for (int t : lights.tri) {
+      vec3f c = scene.tri_p0[size_t(t)] + (scene.tri_e1[size_t(t)] + scene.tri_e2[size_t(t)]) * (1.0f / 3);
+      ratio.push_back(min_ray_epsilon(scene, t, c) / std::sqrt(scene.tri_area[size_t(t)]));
+    }
+    std::nth_element(ratio.begin(), ratio.begin() + ratio.size() / 2, ratio.end());
+    if (ratio[ratio.size() / 2] >= 1)
       std::fprintf(stderr,
-                   "%s: warning: the scene extends to %.3g from the origin, so rays leave surfaces by at least %.3g, "
-                   "more than the size of its lights (median %.3g): their light is lost (the image is too dark); "
-                   "bring far geometry closer\n",
-                   o.scene.c_str(), double(scene.scale), double(offset), double(median));
+                   "%s: warning: the lights are so far from the origin for their size that rays leave surfaces by "
+                   "%.3g times the median light's size: their light is lost (the image is too dark); move the "
+                   "scene nearer the origin\n",
+                   o.scene.c_str(), double(ratio[ratio.size() / 2]));
   }
   if (!o.quiet) {
     auto t_end = std::chrono::steady_clock::now();

@@ -71,9 +71,9 @@ struct shadow_ray {
   float tmax = 0;
 };
 inline shadow_ray shadow_ray_of(const scene_data& scene, const surface_point& sp, const light_sample& ls) {
-  vec3f o = offset_along(sp.p, sp.ng, ls.wi, min_ray_epsilon(scene, sp.p));
+  vec3f o = offset_along(sp.p, sp.ng, ls.wi, min_ray_epsilon(scene, sp.tri, sp.p));
   if (ls.dist == inf_f) return {o, ls.wi, inf_f};
-  vec3f target = offset_along(ls.p, ls.n, -ls.wi, min_ray_epsilon(scene, ls.p));
+  vec3f target = offset_along(ls.p, ls.n, -ls.wi, min_ray_epsilon(scene, ls.tri, ls.p));
   vec3f d = target - o;
   float t = length(d);
   if (!(t > 0)) return {o, ls.wi, 0.0f};
@@ -95,22 +95,22 @@ inline bool unoccluded(const render_inputs& in, const surface_point& sp, const l
 // parallel to it whose plane passes within rounding of p, is traced again from the ray_epsilon offset.
 // hit.t is measured from the origin used.
 // continuation_tnear: where along the ray hits start to count.
-inline float continuation_tnear(const scene_data& scene, vec3f p, vec3f ng, vec3f d) {
-  return min_ray_epsilon(scene, p) / std::max(std::fabs(dot(ng, d)), 0.5f);
+inline float continuation_tnear(const scene_data& scene, int tri, vec3f p, vec3f ng, vec3f d) {
+  return min_ray_epsilon(scene, tri, p) / std::max(std::fabs(dot(ng, d)), 0.5f);
 }
 inline hit_info continuation_hit(const render_inputs& in, int tri, vec3f p, vec3f ng, vec3f d) {
   const scene_data& scene = *in.scene;
-  hit_info h = intersect(*in.bvh, p, d, inf_f, continuation_tnear(scene, p, ng, d));
+  hit_info h = intersect(*in.bvh, p, d, inf_f, continuation_tnear(scene, tri, p, ng, d));
   if (h.tri == invalid_id) return h;
   if (h.tri != tri) {
     // The plane distance in float errs by a few ulps of |p - corner|, which for a large triangle can exceed
     // min_ray_epsilon at p: the tolerance takes 1e-6 of that length on top (about 8 ulps).
     vec3f n = scene.tri_ng[size_t(h.tri)], v = p - scene.tri_p0[size_t(h.tri)];
     bool same_plane = std::fabs(dot(n, ng)) > 0.9999f &&
-                      std::fabs(dot(n, v)) <= min_ray_epsilon(scene, p) + 1e-6f * max_abs_component(v);
+                      std::fabs(dot(n, v)) <= min_ray_epsilon(scene, tri, p) + 1e-6f * max_abs_component(v);
     if (!same_plane) return h;
   }
-  return intersect(*in.bvh, offset_ray_origin(scene, p, ng, d), d);
+  return intersect(*in.bvh, offset_ray_origin(scene, tri, p, ng, d), d);
 }
 
 // Radiance of sample `sample` of pixel (x, y). `ctxs` are the light-selection contexts of the current and the

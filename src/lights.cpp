@@ -56,6 +56,7 @@ light_sample sample_light_point(const light_data& l, const scene_data& scene, in
   int t = l.tri[light];
   vec2f b = sample_triangle(u, v);
   s.p = scene.tri_p0[t] + scene.tri_e1[t] * b.x + scene.tri_e2[t] * b.y;
+  s.tri = t;
   s.n = scene.tri_ng[t];
   // A hole of the emitter's own cut-out emits nothing (rays pass through it; pdf 0: no contribution).
   if (scene.has_alpha && alpha_hole(scene, t, b.x, b.y)) return s;

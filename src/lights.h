@@ -42,6 +42,7 @@ struct light_sample {
   vec3f le;                 // radiance arriving along -wi
   float pdf = 0;            // solid-angle pdf given the light; 0 = no possible contribution
   vec3f p, n;               // the point and the emitter's geometric normal (triangles only)
+  int tri = invalid_id;     // the emitter's triangle (invalid for the sun)
 };
 
 // Samples a point of light `light` seen from x with uniforms (u, v).

@@ -4,6 +4,7 @@
 #include "errors.h"
 #include "texture.h"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace bl {
@@ -19,6 +20,7 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
   s.tri_e2.resize(n);
   s.tri_ng.resize(n);
   s.tri_area.resize(n);
+  s.tri_extent.resize(n);
   for (int t = 0; t < n; t++) {
     vec3f p0 = m.positions[m.tri_positions[3 * t + 0]];
     vec3f p1 = m.positions[m.tri_positions[3 * t + 1]];
@@ -31,6 +33,7 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
     s.tri_e2[t] = e2;
     s.tri_ng[t] = len > 0 ? c / len : vec3f{0, 0, 1};
     s.tri_area[t] = 0.5f * len;
+    s.tri_extent[t] = std::max({max_abs_component(p0), max_abs_component(p1), max_abs_component(p2)});
     s.bounds = merge(merge(merge(s.bounds, p0), p1), p2);
   }
   s.material_emissive.resize(m.materials.size());
@@ -38,8 +41,6 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
     s.material_emissive[i] = !is_black(m.materials[i].ke);
     s.has_alpha = s.has_alpha || m.materials[i].alpha_texture != invalid_id;
   }
-  s.scale = is_empty(s.bounds) ? 1.0f : std::max(max_abs_component(s.bounds.lo), max_abs_component(s.bounds.hi));
-  if (!(s.scale > 0)) s.scale = 1;
   s.camera = camera;
   if (camera.automatic || camera.frame_eye || camera.frame_target) {
     camera_params f = frame_bounds(s.bounds, camera.fov_y_deg, aspect);

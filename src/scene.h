@@ -20,8 +20,8 @@ struct scene_data {
   std::vector<vec3f> tri_ng;                  // unit geometric normal, cross(e1, e2) direction (CCW front)
   std::vector<float> tri_area;
   std::vector<uint8_t> material_emissive;     // per material: Ke non-zero
+  std::vector<float> tri_extent;              // largest |coordinate| of the triangle's corners (ray offsets)
   bbox3f bounds;
-  float scale = 1;                            // largest |coordinate| of the bounds (ray offsets)
   camera_params camera;
   sun_params sun;
   bool two_sided_emitters = false;
@@ -52,20 +52,23 @@ vec2f surface_uv(const scene_data& scene, int tri, float b1, float b2);
 // Whether that point is a hole of its material's map_d cut-out (alpha < 0.5): no hit, no shadow, no emission.
 bool alpha_hole(const scene_data& scene, int tri, float b1, float b2);
 
-// Distance to offset a ray origin at p off its surface: scale-aware (relative to the scene's magnitude).
-inline float ray_epsilon(const scene_data& scene, vec3f p) {
-  return 2e-5f * std::max(max_abs_component(p), 0.05f * scene.scale);
+// Distance to offset a ray origin at p, a point of triangle tri, off its surface: a share of p's largest coordinate,
+// and at least a share of the triangle's own largest (a point near the origin on a huge triangle is interpolated from
+// corners far from it and errs by their rounding). Per triangle, so that far geometry (a ground plane reaching 1e8)
+// does not move rays off the small things near the origin by more than their size.
+inline float ray_epsilon(const scene_data& scene, int tri, vec3f p) {
+  return 2e-5f * std::max(max_abs_component(p), 0.05f * scene.tri_extent[size_t(tri)]);
 }
 // p moved off its surface along the normal n toward the side of direction d, by eps.
 inline vec3f offset_along(vec3f p, vec3f n, vec3f d, float eps) {
   return dot(n, d) >= 0 ? p + n * eps : p - n * eps;
 }
-inline vec3f offset_ray_origin(const scene_data& scene, vec3f p, vec3f n, vec3f d) {
-  return offset_along(p, n, d, ray_epsilon(scene, p));
+inline vec3f offset_ray_origin(const scene_data& scene, int tri, vec3f p, vec3f n, vec3f d) {
+  return offset_along(p, n, d, ray_epsilon(scene, tri, p));
 }
 // The least offset off a surface: 1/20 of ray_epsilon (8 to 17 float ulps of p's largest coordinate: what the hit
 // point's rounding needs). Rays start this far off (shadow rays) or count hits from this height on (continuation
 // rays), so that a lamp or an occluder closer to a surface than ray_epsilon is not stepped over.
-inline float min_ray_epsilon(const scene_data& scene, vec3f p) { return 0.05f * ray_epsilon(scene, p); }
+inline float min_ray_epsilon(const scene_data& scene, int tri, vec3f p) { return 0.05f * ray_epsilon(scene, tri, p); }
 
 }  // namespace bl

@@ -299,7 +299,7 @@ TEST_CASE("a grazing continuation ray hits neither the triangle it leaves nor a 
       vec3f u = cross(sp.ng, t);
       double phi = 2 * M_PI * unit(), lift = std::pow(10.0, -8 + 6 * unit());
       vec3f d = normalize(t * float(std::cos(phi)) + u * float(std::sin(phi)) + sp.ng * float(lift));
-      int raw = intersect(b->bvh, sp.p, d, inf_f, continuation_tnear(b->scene, sp.p, sp.ng, d)).tri;
+      int raw = intersect(b->bvh, sp.p, d, inf_f, continuation_tnear(b->scene, tri, sp.p, sp.ng, d)).tri;
       raw_self += raw == tri;
       raw_other += raw == 1 - tri;
       hits += continuation_hit(in, tri, sp.p, sp.ng, d).tri != invalid_id;
