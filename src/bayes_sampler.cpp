@@ -444,7 +444,12 @@ void bayes_sampler::flush_check(const row_state& row) const {
     return;
   }
   // One sample in this pass: half the squared difference to the pixel's sample of the pass before (both passes of
-  // one spp) is an unbiased estimate of its variance.
+  // one spp) is an unbiased estimate of its variance. A pass of one spp after one of more (a --spp total cut short)
+  // has no columns: nothing to pair with, and the pass is not counted.
+  if (px_cur.size() != px_var.size()) {
+    px_var[i] = 0;
+    return;
+  }
   float y = float(row.check_mean);
   double d = double(y) - px_prev[i];
   px_var[i] = std::isfinite(px_prev[i]) ? 0.5 * d * d : 0.0;
@@ -468,8 +473,9 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
   if (px_var.size() == n) {
     for (const row_state& r : rows)
       if (r.check_pixel >= 0) flush_check(r);
-    check_pairs = pass_spp == 1;  // the next pass of one spp has this pass's samples to pair with
-    if (pass_spp == 1 && px_cur.size() == n) px_prev.swap(px_cur);  // (every pixel had its one sample)
+    // The next pass of one spp has this pass's samples to pair with (every pixel had its one sample).
+    check_pairs = pass_spp == 1 && px_cur.size() == n;
+    if (check_pairs) px_prev.swap(px_cur);
   }
   if (px_var.size() == n && paired && spp >= 4) {
     // Summed over the pass's samples with relMSE's weights 1 / (m^2 + 0.01), m the pixel's mean luminance with this

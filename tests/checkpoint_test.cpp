@@ -110,6 +110,20 @@ TEST_CASE("a finished render can be resumed further", "[checkpoint]") {
   CHECK(read_file(d / "resumed.pfm") == read_file(d / "full.pfm"));
 }
 
+TEST_CASE("a checkpoint resumed for one spp more after a pass of several goes on", "[checkpoint]") {
+  // The pass after 10 spp is cut to one spp by the total of 11; the fallback check had no columns for a pass of one
+  // after one of several, and the resumed render crashed (exit 139) at its first pixel (a review).
+  temp_dir d;
+  std::string ck = d / "ck.bin";
+  std::string args = "render " + source_path("data/cornell/direct.json") + " --sampler bayes --width 80 --height 60 --quiet";
+  REQUIRE(run_bayeslight(args + " --spp 10 -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
+  auto resumed = run_bayeslight(args + " --spp 11 -o " + (d / "resumed.pfm") + " --resume " + ck);
+  INFO(resumed.output);
+  REQUIRE(resumed.status == 0);
+  REQUIRE(run_bayeslight(args + " --spp 11 -o " + (d / "full.pfm")).status == 0);
+  CHECK(read_file(d / "resumed.pfm") == read_file(d / "full.pfm"));
+}
+
 TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[checkpoint]") {
   temp_dir d;
   std::string ck = d / "ck.bin";
