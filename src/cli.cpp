@@ -151,6 +151,7 @@ image_data load_reference(const std::string& path, const render_params& params) 
 }
 
 int run_render(const render_options& o) {
+  install_interrupt_handlers();  // (a signal while the scene loads ends the command once it has loaded)
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
@@ -185,7 +186,7 @@ int run_render(const render_options& o) {
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
   if (o.frames > 1 && !(desc.sun.enabled && desc.sun.animated))
-    std::fprintf(stderr, "%s: warning: %s, so the %d frames are the same image (the sun moves to sun.direction_end)\n",
+    std::fprintf(stderr, "%s: warning: %s, so the %d frames show the same scene (the sun moves to sun.direction_end)\n",
                  o.scene.c_str(), desc.sun.enabled ? "the sun has no \"direction_end\"" : "the scene has no sun",
                  o.frames);
   std::vector<image_data> references;
@@ -244,8 +245,10 @@ int run_render(const render_options& o) {
       decode_checkpoint(resume_bytes, o.resume, fingerprint, params.pass_weighting, r, s);
       // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
       if (params.time_budget <= 0 && r.spp > params.spp)
-        throw usage_error("--spp " + std::to_string(params.spp) + " is below the " + std::to_string(r.spp) +
-                          " spp already in " + o.resume);
+        throw usage_error((o.spp > 0 ? "--spp " + std::to_string(params.spp)
+                                     : "the scene's render.spp (" + std::to_string(params.spp) + ")") +
+                          " is below the " + std::to_string(r.spp) + " spp already in " + o.resume + ": give --spp " +
+                          std::to_string(r.spp) + " or more, or --time");
     };
   auto last_write = std::chrono::steady_clock::now();
   // A checkpoint that cannot be written (a full disk) is reported and the render goes on: its image is still
@@ -268,7 +271,7 @@ int run_render(const render_options& o) {
     if (!last && o.kill_after_passes > 0 && r.passes == o.kill_after_passes) std::raise(SIGKILL);
   };
 
-  install_interrupt_handlers();
+  if (int status = interrupted_before_render()) return status;
   bool interrupted = false;
   render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
     std::vector<std::string> files;
@@ -494,6 +497,7 @@ void add_profile_command(CLI::App& app, render_options& o) {
 }
 
 int run_profile_command(const render_options& o) {
+  install_interrupt_handlers();
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
@@ -503,7 +507,7 @@ int run_profile_command(const render_options& o) {
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
-  install_interrupt_handlers();
+  if (int status = interrupted_before_render()) return status;
   std::string report = profile_render(scene, bvh, lights, params, o.scene + " with the " + o.sampler + " sampler");
   std::fputs(report.c_str(), stdout);
   return interrupt_signal() != 0 ? 128 + interrupt_signal() : exit_ok;
@@ -527,6 +531,7 @@ void add_compare_command(CLI::App& app, compare_options& o) {
 }
 
 int run_compare_command(const compare_options& o) {
+  install_interrupt_handlers();  // (a signal while the scene loads ends the command once it has loaded)
   compare_params cp;
   for (const std::string& name : o.samplers) {
     sampler_kind kind;

@@ -308,7 +308,7 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", params.scene_path.c_str());
   make_output_dir(params.out_dir);
 
-  install_interrupt_handlers();
+  if (int status = interrupted_before_render()) return status;
   compare_data data = run_comparison(scene, bvh, lights, reference, params);
   write_comparison(data, params, reference);
   if (!params.quiet || data.signal != 0)

@@ -105,12 +105,23 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
   plain.profile = false;
   plain.progress = false;
   render_result a = render(scene, bvh, lights, plain);
+  auto cut_short = [&](const char* which, const render_result& r) {
+    return "profile of " + title + ": interrupted during the " + which + " render (at " + std::to_string(r.spp) +
+           " spp); no report\n";
+  };
+  if (a.interrupted) return cut_short("plain", a);
+  // The timed render takes the plain one's samples (with --time the plain render's budget fixed their number), so
+  // both do the same work: the stage times are per NEE sample of that work, and the timers' cost is a fair ratio.
   render_params timed = plain;
   timed.profile = true;
+  timed.time_budget = 0;
+  timed.spp = std::max(a.spp, 1);
   render_result b = render(scene, bvh, lights, timed);
+  if (b.interrupted) return cut_short("timed", b);
   double hz = tsc_hz();
   const path_stats& st = a.stats;
   double nee = double(std::max<uint64_t>(st.nee_samples, 1));
+  double nee_b = double(std::max<uint64_t>(b.stats.nee_samples, 1));
   ray_set rays = make_shadow_rays(scene, bvh, lights, params.width, params.height,
                                   std::min<size_t>(std::max<uint64_t>(st.shadow_rays, 1), size_t(4) << 20));
   double limit = occlusion_rate(bvh, rays, threads);
@@ -128,6 +139,7 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
        "%.2f M, bounce %.2f M)\n",
        a.seconds, a.passes, nee * 1e-6, nee / a.seconds * 1e-6, rays_total / a.seconds * 1e-6,
        double(st.camera_rays) * 1e-6, double(st.shadow_rays) * 1e-6, double(st.bounce_rays) * 1e-6);
+  line("  timed render: the same %d spp, %.3f s; stages below per NEE sample of it\n", b.spp, b.seconds);
   // Stage times are per-thread cycles; in wall time per NEE sample they are divided by the thread count.
   double pass_wall = b.seconds - b.learn_seconds;
   double staged = 0;
@@ -135,25 +147,25 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
   line("\n  %-44s %10s %8s\n", "stage (timed render)", "ns/NEE", "share");
   for (int c = 0; c < prof_count; c++) {
     double wall = double(b.profile_cycles[c]) / hz / threads;
-    line("  %-44s %10.1f %7.1f%%\n", stage_name(c), wall / nee * 1e9, 100 * wall / b.seconds);
+    line("  %-44s %10.1f %7.1f%%\n", stage_name(c), wall / nee_b * 1e9, 100 * wall / b.seconds);
   }
   double rest = std::max(0.0, pass_wall - staged);
-  line("  %-44s %10.1f %7.1f%%\n", "film, scheduling and timer overhead", rest / nee * 1e9, 100 * rest / b.seconds);
-  line("  %-44s %10.1f %7.1f%%\n", "between passes: reduction + PMF rebuild", b.learn_seconds / nee * 1e9,
+  line("  %-44s %10.1f %7.1f%%\n", "film, scheduling and timer overhead", rest / nee_b * 1e9, 100 * rest / b.seconds);
+  line("  %-44s %10.1f %7.1f%%\n", "between passes: reduction + PMF rebuild", b.learn_seconds / nee_b * 1e9,
        100 * b.learn_seconds / b.seconds);
   const learn_timing& lp = b.learn_parts;
   if (lp.reduce + lp.regions + lp.refold > 0) {
-    line("  %-44s %10.1f %7.1f%%\n", "  of which: fold of observation records", lp.reduce / nee * 1e9,
+    line("  %-44s %10.1f %7.1f%%\n", "  of which: fold of observation records", lp.reduce / nee_b * 1e9,
          100 * lp.reduce / b.seconds);
-    line("  %-44s %10.1f %7.1f%%\n", "  of which: new regions (cuts, prior means)", lp.regions / nee * 1e9,
+    line("  %-44s %10.1f %7.1f%%\n", "  of which: new regions (cuts, prior means)", lp.regions / nee_b * 1e9,
          100 * lp.regions / b.seconds);
-    line("  %-44s %10.1f %7.1f%%\n", "  of which: refold of changed weights", lp.refold / nee * 1e9,
+    line("  %-44s %10.1f %7.1f%%\n", "  of which: refold of changed weights", lp.refold / nee_b * 1e9,
          100 * lp.refold / b.seconds);
     line("  %-44s %10.2f records, %.2f refolds per NEE sample (%.1f, %.1f ns each)\n", "  learning work:",
-         lp.records / nee, lp.refolds / nee, lp.reduce / std::max(lp.records, 1.0) * 1e9,
+         lp.records / nee_b, lp.refolds / nee_b, lp.reduce / std::max(lp.records, 1.0) * 1e9,
          lp.refold / std::max(lp.refolds, 1.0) * 1e9);
   }
-  line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee * 1e9, 100.0);
+  line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee_b * 1e9, 100.0);
   line("\n  raw Embree rtcOccluded1 on this scene: %.2f M rays/s (%zu rays, %d threads)\n", limit * 1e-6,
        rays.org.size(), threads);
   if (limit > 0) {
@@ -172,7 +184,7 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
     line("\n");
     // Each NEE sample of a direct-only render pays one camera ray: with one NEE sample per camera hit the fraction
     // cannot exceed t_raw / (t_raw + t_camera) even if everything else were free.
-    double t_raw = 1 / limit, t_cam = stage_wall(prof_camera) / nee;
+    double t_raw = 1 / limit, t_cam = stage_wall(prof_camera) / nee_b;
     if (params.max_depth == 1 && t_cam > 0)
       line("  with one NEE sample per camera ray the fraction is at most %.2f (a camera ray costs %.1f raw shadow rays "
            "here)\n", t_raw / (t_raw + t_cam), t_cam / t_raw);

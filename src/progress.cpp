@@ -46,7 +46,8 @@ void progress_bar::run() {
 }
 
 void progress_bar::draw(bool final_line) {
-  double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  double elapsed = counters_.seconds_before.load() +
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   int done = counters_.spp_done.load(), target = counters_.spp_target.load();
   double budget = counters_.time_budget.load();
   int rows = std::max(1, counters_.rows.load());

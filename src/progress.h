@@ -16,6 +16,7 @@ struct progress_counters {
   std::atomic<int> spp_done{0};
   std::atomic<int> spp_target{0};       // 0 when rendering against a time budget
   std::atomic<double> time_budget{0};
+  std::atomic<double> seconds_before{0}; // render time already spent (a resumed render's), counted as elapsed
   std::atomic<int> rows_done{0};        // rows of the running pass
   std::atomic<int> rows{1};
   std::atomic<int> pass_spp{0};         // samples per pixel of the running pass

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <climits>
 #include <csignal>
+#include <pthread.h>
 #include <thread>
 #include <type_traits>
 
@@ -166,6 +167,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   progress_counters progress;
   progress.spp_target = params.time_budget > 0 ? 0 : params.spp;
   progress.time_budget = params.time_budget;
+  progress.seconds_before = result.seconds;
   progress.rows = h;
   progress_bar bar(progress, params.progress);
 
@@ -370,8 +372,22 @@ image_data film_image(const render_result& r) {
 void install_interrupt_handlers() {
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
+  // A process started with them blocked (a launcher's mask is inherited) could not be interrupted at all; one that
+  // arrived meanwhile is delivered now.
+  sigset_t s;
+  sigemptyset(&s);
+  sigaddset(&s, SIGINT);
+  sigaddset(&s, SIGTERM);
+  pthread_sigmask(SIG_UNBLOCK, &s, nullptr);
 }
 int interrupt_signal() { return g_signal.load(); }
 void reset_interrupt() { g_signal.store(0); }
+int interrupted_before_render() {
+  int sig = g_signal.load();
+  if (sig == 0) return 0;
+  std::fprintf(stderr, "bayeslight: interrupted (%s) while loading the scene; nothing written\n",
+               sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "signal");
+  return 128 + sig;
+}
 
 }  // namespace bl

@@ -105,5 +105,8 @@ void install_interrupt_handlers();
 int interrupt_signal();
 // Clears a pending interrupt request (tests).
 void reset_interrupt();
+// For a signal that arrived before the first pass (the handlers are installed before the scene loads): says so on
+// stderr and returns the exit status, 128 + signal; 0 when none did.
+int interrupted_before_render();
 
 }  // namespace bl

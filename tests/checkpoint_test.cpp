@@ -260,3 +260,21 @@ TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed
     }
   }
 }
+
+TEST_CASE("resuming to fewer spp than a checkpoint holds says where the smaller count came from", "[checkpoint]") {
+  // Without --spp the count is the scene's render.spp; the message said "--spp 64", an option never given (a review).
+  temp_dir d;
+  std::string ck = d / "ck.bin";
+  std::string args = "render " + source_path("data/cornell/direct.json") + " --sampler power --width 16 --height 12 --quiet";
+  REQUIRE(run_bayeslight(args + " --spp 100 -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
+  auto given = run_bayeslight(args + " --spp 50 -o " + (d / "b.pfm") + " --resume " + ck);
+  INFO(given.output);
+  CHECK(given.status == 2);
+  CHECK(given.output.find("--spp 50 is below the 100 spp already in " + ck) != std::string::npos);
+  auto scene = run_bayeslight(args + " -o " + (d / "b.pfm") + " --resume " + ck);
+  INFO(scene.output);
+  CHECK(scene.status == 2);
+  CHECK(scene.output.find("the scene's render.spp (64) is below the 100 spp already in " + ck +
+                          ": give --spp 100 or more, or --time") != std::string::npos);
+  CHECK(!std::filesystem::exists(d / "b.pfm"));
+}
