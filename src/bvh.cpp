@@ -143,7 +143,13 @@ hit_info intersect(const bvh_data& b, vec3f org, vec3f dir, float tmax, float tn
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(b.scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
-  return intersect_triangle(*b.source, int(rh.hit.primID), org, dir);
+  int tri = int(rh.hit.primID);
+  // Of two faces of one sheet (reversed twins, at the same distance), the ray meets the one facing it: Embree
+  // reports either, and from its back a lamp's face would be black while its twin emits toward the ray.
+  const scene_data& s = *b.source;
+  if (!s.tri_twin.empty() && s.tri_twin[size_t(tri)] != invalid_id && dot(s.tri_ng[size_t(tri)], dir) > 0)
+    tri = s.tri_twin[size_t(tri)];
+  return intersect_triangle(s, tri, org, dir);
 }
 
 bool occluded(const bvh_data& b, vec3f org, vec3f dir, float tmax) {

@@ -13,6 +13,13 @@ light_data build_lights(const scene_data& scene) {
   l.light_of_tri.assign(n, invalid_id);
   for (int t = 0; t < n; t++) {
     if (!scene.material_emissive[m.tri_materials[t]]) continue;
+    // Both sides of each emitter emit: an emissive reversed twin of an earlier one repeats it (the same light seen
+    // from either face), and only the earlier one is sampled.
+    int twin = scene.tri_twin.empty() ? invalid_id : scene.tri_twin[size_t(t)];
+    if (l.two_sided && twin != invalid_id && twin < t && l.light_of_tri[size_t(twin)] != invalid_id) {
+      l.light_of_tri[t] = l.light_of_tri[size_t(twin)];
+      continue;
+    }
     l.light_of_tri[t] = int(l.tri.size());
     l.tri.push_back(t);
     vec3f le = m.materials[m.tri_materials[t]].ke;

@@ -103,7 +103,8 @@ static void ear_clip(const std::vector<double>& x, const std::vector<double>& y,
 }
 
 // Triangulates one polygon with corner positions p into n-2 triangles of local corner indices (winding kept).
-// Convex quads split along the shorter diagonal (as tinyobjloader does), other convex polygons fan from
+// Convex quads split along the shorter diagonal (as tinyobjloader does; of equal ones, the one through the smallest
+// corner), other convex polygons fan from
 // corner 0, concave ones are ear-clipped in the plane of their Newell normal.
 static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& st, std::vector<int>& tris) {
   int n = int(p.size());
@@ -133,8 +134,19 @@ static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& 
     convex = cross2(x.data(), y.data(), (i + n - 1) % n, i, (i + 1) % n) >= 0;
   if (flat || convex) {
     if (n == 4) {
-      vec3f e02 = p[2] - p[0], e13 = p[3] - p[1];
-      if (length_sq(e02) < length_sq(e13)) return tris.assign({0, 1, 2, 0, 2, 3});
+      float d02 = length_sq(p[2] - p[0]), d13 = length_sq(p[3] - p[1]);
+      bool split02 = d02 < d13;
+      if (d02 == d13) {
+        // Equal diagonals (every rectangle): the one through the smallest corner (x, then y, then z), whatever the
+        // corners' order, so that the two faces of a sheet written as a quad and its reverse are exact reversed twins
+        // (scene.h): a ray then meets the face turned toward it.
+        auto less = [](vec3f a, vec3f b) { return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z; };
+        int m = 0;
+        for (int i = 1; i < 4; i++)
+          if (less(p[i], p[m])) m = i;
+        split02 = m % 2 == 0;
+      }
+      if (split02) return tris.assign({0, 1, 2, 0, 2, 3});
       return tris.assign({0, 1, 3, 1, 2, 3});
     }
     for (int i = 1; i + 1 < n; i++) tris.insert(tris.end(), {0, i, i + 1});
@@ -265,27 +277,28 @@ static tinyobj_result parse_clean(const std::string& path, const obj_clean_data&
   return r;
 }
 
+corner_key triangle_corner_key(const std::vector<vec3f>& positions, const int* corners, bool reversed) {
+  std::array<std::array<uint32_t, 3>, 3> c{};
+  for (int i = 0; i < 3; i++) {
+    int k = reversed && i > 0 ? 3 - i : i;
+    vec3f p = positions[size_t(corners[k])] + vec3f{0, 0, 0};  // (-0 + 0 = +0)
+    std::memcpy(c[size_t(i)].data(), &p, sizeof p);
+  }
+  int r = 0;
+  for (int i = 1; i < 3; i++)
+    if (c[size_t(i)] < c[size_t(r)]) r = i;
+  corner_key key{};
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) key[size_t(3 * i + j)] = c[size_t((r + i) % 3)][size_t(j)];
+  return key;
+}
+
 // Drops emissive triangles that repeat an earlier emissive one exactly (the same three corners in the same cyclic
 // order: the same side emits): light sampling would count every copy while a ray sees one, so next-event and
 // BSDF-sampled estimates of that light would disagree. Returns how many were dropped. Keeps file order.
 static int drop_repeated_emitters(mesh_data& mesh, const std::vector<vec3f>& pos, const std::vector<char>& emissive) {
   size_t n = mesh.tri_materials.size();
-  // Each emissive triangle's corners as 9 float bit patterns, rotated to start at its smallest corner (-0 written
-  // as 0: the same point, other bits).
-  auto key = [&](size_t t) {
-    std::array<uint32_t, 9> k{};
-    std::array<std::array<uint32_t, 3>, 3> c{};
-    for (int i = 0; i < 3; i++) {
-      vec3f p = pos[size_t(mesh.tri_positions[3 * t + size_t(i)])] + vec3f{0, 0, 0};  // (-0 + 0 = +0)
-      std::memcpy(c[size_t(i)].data(), &p, sizeof p);
-    }
-    int r = 0;
-    for (int i = 1; i < 3; i++)
-      if (c[size_t(i)] < c[size_t(r)]) r = i;
-    for (int i = 0; i < 3; i++)
-      for (int j = 0; j < 3; j++) k[size_t(3 * i + j)] = c[size_t((r + i) % 3)][size_t(j)];
-    return k;
-  };
+  auto key = [&](size_t t) { return triangle_corner_key(pos, &mesh.tri_positions[3 * t]); };
   std::vector<std::pair<std::array<uint32_t, 9>, uint32_t>> keys;
   for (size_t t = 0; t < n; t++)
     if (emissive[size_t(mesh.tri_materials[t])]) keys.push_back({key(t), uint32_t(t)});

@@ -8,6 +8,8 @@
 #include "math.h"
 #include "texture.h"
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -47,6 +49,12 @@ struct mesh_data {
 };
 
 inline int triangle_count(const mesh_data& m) { return int(m.tri_materials.size()); }
+
+// A triangle's corners (indices into positions) as 9 float bit patterns (-0 as +0: the same point), rotated to start
+// at the smallest corner: two triangles have the same key when they have the same corners in the same cyclic order
+// (the same side in front). `reversed`: the key of its other side (corners 0, 2, 1).
+using corner_key = std::array<uint32_t, 9>;
+corner_key triangle_corner_key(const std::vector<vec3f>& positions, const int* corners, bool reversed = false);
 
 // Loads an OBJ file with its MTL libraries (relative to the OBJ's folder) and the map_Kd / map_d textures of
 // the materials it uses (relative to their MTL's folder). Unrecognised statements are reported on stderr.

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 
 namespace bl {
 
@@ -35,6 +36,42 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
     s.tri_area[t] = 0.5f * len;
     s.tri_extent[t] = std::max({max_abs_component(p0), max_abs_component(p1), max_abs_component(p2)});
     s.bounds = merge(merge(merge(s.bounds, p0), p1), p2);
+  }
+  // Reversed twins: of the triangles with the same three corners (grouped by a hash of the corner set, independent
+  // of their order), the lowest-numbered one whose key is this one's reversed key.
+  auto mix = [](uint64_t v) {  // splitmix64's finaliser
+    v = (v ^ (v >> 30)) * 0xbf58476d1ce4e5b9ull;
+    v = (v ^ (v >> 27)) * 0x94d049bb133111ebull;
+    return v ^ (v >> 31);
+  };
+  std::vector<std::pair<uint64_t, int>> groups(static_cast<size_t>(n));
+  for (int t = 0; t < n; t++) {
+    uint64_t h = 0;
+    for (int i = 0; i < 3; i++) {
+      vec3f p = m.positions[size_t(m.tri_positions[3 * size_t(t) + size_t(i)])] + vec3f{0, 0, 0};  // (-0 as +0)
+      uint32_t b[3];
+      std::memcpy(b, &p, sizeof b);
+      h += mix((uint64_t(b[0]) << 32 | b[1]) ^ mix(b[2]));
+    }
+    groups[size_t(t)] = {h, t};
+  }
+  std::sort(groups.begin(), groups.end());
+  std::vector<std::pair<corner_key, int>> keys;
+  for (size_t g = 0, e; g < groups.size(); g = e) {
+    for (e = g + 1; e < groups.size() && groups[e].first == groups[g].first;) e++;
+    if (e - g < 2) continue;
+    keys.clear();
+    for (size_t k = g; k < e; k++)
+      keys.push_back({triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(groups[k].second)]), groups[k].second});
+    std::sort(keys.begin(), keys.end());
+    for (size_t k = g; k < e; k++) {
+      int t = groups[k].second;
+      std::pair<corner_key, int> rev{triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(t)], true), -1};
+      auto it = std::lower_bound(keys.begin(), keys.end(), rev);
+      if (it == keys.end() || it->first != rev.first || it->second == t) continue;
+      if (s.tri_twin.empty()) s.tri_twin.assign(size_t(n), invalid_id);
+      s.tri_twin[size_t(t)] = it->second;
+    }
   }
   s.material_emissive.resize(m.materials.size());
   for (size_t i = 0; i < m.materials.size(); i++) {

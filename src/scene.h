@@ -21,6 +21,9 @@ struct scene_data {
   std::vector<float> tri_area;
   std::vector<uint8_t> material_emissive;     // per material: Ke non-zero
   std::vector<float> tri_extent;              // largest |coordinate| of the triangle's corners (ray offsets)
+  // Per triangle: its reversed twin (the same corners in the opposite order: the other face of a two-faced sheet,
+  // e.g. a lamp emitting on both sides from two faces), or invalid_id; empty when no triangle has one.
+  std::vector<int> tri_twin;
   bbox3f bounds;
   camera_params camera;
   sun_params sun;

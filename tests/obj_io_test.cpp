@@ -3,6 +3,7 @@
 // file and line. Each test writes its OBJ/MTL/PNG files into a fresh mkdtemp directory.
 #include "errors.h"
 #include "obj_io.h"
+#include "scene.h"
 
 #include <catch2/catch.hpp>
 #include <stb_image_write.h>
@@ -105,6 +106,30 @@ TEST_CASE("a quad and a pentagon are triangulated with their winding kept", "[ob
   CHECK(quad_area == Approx(1.0f));
   CHECK(pentagon_area == Approx(2.5f));  // shoelace area of the pentagon
   CHECK(m.dropped_degenerate == 0);
+}
+
+TEST_CASE("a rectangle and its reverse are triangulated as exact reversed twins, in any corner order", "[obj]") {
+  // Equal diagonals: the split went by corner order (1-3), so a quad and its reverse were split along different
+  // diagonals and their faces overlapped without being twins (a review: a two-faced lamp written as quads).
+  temp_dir dir;
+  auto obj = dir.write("q.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
+                                "f 1 2 3 4\nf 4 3 2 1\nf 2 3 4 1\nf 1 4 3 2\nf 3 2 1 4\n");
+  mesh_data m = load_obj(obj);
+  REQUIRE(triangle_count(m) == 10);
+  scene_data s = build_scene(m, camera_params{}, sun_params{}, false, 1.0f);
+  REQUIRE(s.tri_twin.size() == 10);
+  for (int t = 0; t < 10; t++) {
+    INFO("triangle " << t);
+    int w = s.tri_twin[size_t(t)];
+    REQUIRE(w != invalid_id);
+    CHECK(triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(w)]) ==
+          triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(t)], true));
+    CHECK(dot(s.tri_ng[size_t(t)], s.tri_ng[size_t(w)]) < 0);
+  }
+  // A lone quad has no twin, and the column stays empty.
+  scene_data lone = build_scene(load_obj(dir.write("l.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4\n")),
+                                camera_params{}, sun_params{}, false, 1.0f);
+  CHECK(lone.tri_twin.empty());
 }
 
 TEST_CASE("a concave polygon in a tilted plane is triangulated inside its outline", "[obj]") {
