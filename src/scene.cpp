@@ -61,8 +61,10 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
     for (e = g + 1; e < groups.size() && groups[e].first == groups[g].first;) e++;
     if (e - g < 2) continue;
     keys.clear();
-    for (size_t k = g; k < e; k++)
-      keys.push_back({triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(groups[k].second)]), groups[k].second});
+    for (size_t k = g; k < e; k++) {
+      int t = groups[k].second;
+      keys.push_back({triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(t)]), t});
+    }
     std::sort(keys.begin(), keys.end());
     for (size_t k = g; k < e; k++) {
       int t = groups[k].second;

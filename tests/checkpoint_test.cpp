@@ -115,7 +115,8 @@ TEST_CASE("a checkpoint resumed for one spp more after a pass of several goes on
   // after one of several, and the resumed render crashed (exit 139) at its first pixel (a review).
   temp_dir d;
   std::string ck = d / "ck.bin";
-  std::string args = "render " + source_path("data/cornell/direct.json") + " --sampler bayes --width 80 --height 60 --quiet";
+  std::string args =
+      "render " + source_path("data/cornell/direct.json") + " --sampler bayes --width 80 --height 60 --quiet";
   REQUIRE(run_bayeslight(args + " --spp 10 -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
   auto resumed = run_bayeslight(args + " --spp 11 -o " + (d / "resumed.pfm") + " --resume " + ck);
   INFO(resumed.output);
@@ -265,7 +266,8 @@ TEST_CASE("resuming to fewer spp than a checkpoint holds says where the smaller 
   // Without --spp the count is the scene's render.spp; the message said "--spp 64", an option never given (a review).
   temp_dir d;
   std::string ck = d / "ck.bin";
-  std::string args = "render " + source_path("data/cornell/direct.json") + " --sampler power --width 16 --height 12 --quiet";
+  std::string args =
+      "render " + source_path("data/cornell/direct.json") + " --sampler power --width 16 --height 12 --quiet";
   REQUIRE(run_bayeslight(args + " --spp 100 -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
   auto given = run_bayeslight(args + " --spp 50 -o " + (d / "b.pfm") + " --resume " + ck);
   INFO(given.output);
