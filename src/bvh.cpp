@@ -144,12 +144,16 @@ hit_info intersect(const bvh_data& b, vec3f org, vec3f dir, float tmax, float tn
   rtcIntersect1(b.scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return {};
   int tri = int(rh.hit.primID);
-  // Of two faces of one sheet (reversed twins, at the same distance), the ray meets the one facing it: Embree
-  // reports either, and from its back a lamp's face would be black while its twin emits toward the ray.
   const scene_data& s = *b.source;
-  if (!s.tri_twin.empty() && s.tri_twin[size_t(tri)] != invalid_id && dot(s.tri_ng[size_t(tri)], dir) > 0)
-    tri = s.tri_twin[size_t(tri)];
-  return intersect_triangle(s, tri, org, dir);
+  hit_info h = intersect_triangle(s, tri, org, dir);
+  // Of two faces of one sheet (reversed twins, at the same distance), the ray meets the one facing it: Embree
+  // reports either, and from its back a lamp's face would be black while its twin emits toward the ray. Not where
+  // the twin has a hole of its cut-out (the filter passed the ray through it to this face).
+  if (!s.tri_twin.empty() && s.tri_twin[size_t(tri)] != invalid_id && dot(s.tri_ng[size_t(tri)], dir) > 0) {
+    hit_info w = intersect_triangle(s, s.tri_twin[size_t(tri)], org, dir);
+    if (!(s.has_alpha && alpha_hole(s, w.tri, w.b1, w.b2))) h = w;
+  }
+  return h;
 }
 
 bool occluded(const bvh_data& b, vec3f org, vec3f dir, float tmax) {

@@ -13,18 +13,16 @@ light_data build_lights(const scene_data& scene) {
   l.light_of_tri.assign(n, invalid_id);
   for (int t = 0; t < n; t++) {
     if (!scene.material_emissive[m.tri_materials[t]]) continue;
-    // Both sides of each emitter emit: an emissive reversed twin of an earlier one repeats it (the same light seen
-    // from either face), and only the earlier one is sampled.
-    int twin = scene.tri_twin.empty() ? invalid_id : scene.tri_twin[size_t(t)];
-    if (l.two_sided && twin != invalid_id && twin < t && l.light_of_tri[size_t(twin)] != invalid_id) {
-      l.light_of_tri[t] = l.light_of_tri[size_t(twin)];
-      continue;
-    }
+    // A face with a reversed twin is one side of a sheet: it emits from its front only, also with two_sided (the
+    // other side is its twin's, which a ray from there meets).
+    bool sheets = l.two_sided && !scene.tri_twin.empty();
+    bool front_only = sheets && scene.tri_twin[size_t(t)] != invalid_id;
+    if (sheets) l.front_only.push_back(front_only);
     l.light_of_tri[t] = int(l.tri.size());
     l.tri.push_back(t);
     vec3f le = m.materials[m.tri_materials[t]].ke;
     l.radiance.push_back(le);
-    l.power.push_back(luminance(le) * scene.tri_area[t] * pi_f * (l.two_sided ? 2.0f : 1.0f));
+    l.power.push_back(luminance(le) * scene.tri_area[t] * pi_f * (l.two_sided && !front_only ? 2.0f : 1.0f));
   }
   l.tri_count = int(l.tri.size());
   l.count = l.tri_count;
@@ -73,7 +71,7 @@ light_sample sample_light_point(const light_data& l, const scene_data& scene, in
   s.dist = std::sqrt(dist2);
   s.wi = d / s.dist;
   float cos_l = -dot(s.n, s.wi);
-  if (cos_l < 0 && l.two_sided) cos_l = -cos_l;
+  if (cos_l < 0 && emits_both_sides(l, light)) cos_l = -cos_l;
   if (!(cos_l > 0)) return s;
   s.le = l.radiance[light];
   s.pdf = triangle_light_pdf(scene, l, light, s.dist, cos_l);

@@ -20,6 +20,9 @@ struct light_data {
   int tri_count = 0;            // emissive triangles
   int count = 0;                // tri_count + (sun ? 1 : 0)
   bool two_sided = false;
+  // Per triangle light, with two_sided: it emits from its front only (a face with a reversed twin, scene.h);
+  // empty when none does.
+  std::vector<uint8_t> front_only;
   // The sun: a distant disk of uniform radiance seen under half-angle theta_max.
   int sun = invalid_id;         // its light id, or invalid_id
   vec3f sun_dir;                // unit, from the scene toward the sun
@@ -55,8 +58,11 @@ inline float triangle_light_pdf(const scene_data& scene, const light_data& light
   return cos_l > 0 && a > 0 ? dist * dist / (cos_l * a) : 0;
 }
 // Radiance an emissive triangle sends toward a ray that hit its front (front=true) or back side.
+inline bool emits_both_sides(const light_data& lights, int light) {
+  return lights.two_sided && (lights.front_only.empty() || !lights.front_only[size_t(light)]);
+}
 inline vec3f emitted_radiance(const light_data& lights, int light, bool front) {
-  return front || lights.two_sided ? lights.radiance[light] : vec3f{0, 0, 0};
+  return front || emits_both_sides(lights, light) ? lights.radiance[light] : vec3f{0, 0, 0};
 }
 // Whether a direction (unit length) lies inside the sun's disk: |dir - sun_dir|^2 = 2 (1 - cos) for unit vectors,
 // without the cancellation of 1 - dot near 1 (which took every direction within 2.4e-4 rad for a disk of 0.01

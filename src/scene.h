@@ -60,7 +60,7 @@ bool alpha_hole(const scene_data& scene, int tri, float b1, float b2);
 // corners far from it and errs by their rounding). Per triangle, so that far geometry (a ground plane reaching 1e8)
 // does not move rays off the small things near the origin by more than their size.
 inline float ray_epsilon(const scene_data& scene, int tri, vec3f p) {
-  return 2e-5f * std::max(max_abs_component(p), 0.05f * scene.tri_extent[size_t(tri)]);
+  return 2e-5f * std::max(max_abs_component(p), 0.5f * scene.tri_extent[size_t(tri)]);
 }
 // p moved off its surface along the normal n toward the side of direction d, by eps.
 inline vec3f offset_along(vec3f p, vec3f n, vec3f d, float eps) {
@@ -69,8 +69,9 @@ inline vec3f offset_along(vec3f p, vec3f n, vec3f d, float eps) {
 inline vec3f offset_ray_origin(const scene_data& scene, int tri, vec3f p, vec3f n, vec3f d) {
   return offset_along(p, n, d, ray_epsilon(scene, tri, p));
 }
-// The least offset off a surface: 1/20 of ray_epsilon (8 to 17 float ulps of p's largest coordinate: what the hit
-// point's rounding needs). Rays start this far off (shadow rays) or count hits from this height on (continuation
+// The least offset off a surface: 1/20 of ray_epsilon (8 to 17 float ulps of p's largest coordinate, and 4 to 8 of
+// its triangle's: what the hit point's rounding needs; a point near the origin interpolated from corners of size 1
+// errs by more than half an ulp of 1, and a floor of 0.4 ulps let a tilted tile shadow itself under a low sun). Rays start this far off (shadow rays) or count hits from this height on (continuation
 // rays), so that a lamp or an occluder closer to a surface than ray_epsilon is not stepped over.
 inline float min_ray_epsilon(const scene_data& scene, int tri, vec3f p) { return 0.05f * ray_epsilon(scene, tri, p); }
 
