@@ -2,6 +2,7 @@
 #include "scene.h"
 
 #include "errors.h"
+#include "rng.h"
 #include "texture.h"
 
 #include <algorithm>
@@ -39,11 +40,6 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
   }
   // Reversed twins: of the triangles with the same three corners (grouped by a hash of the corner set, independent
   // of their order), the lowest-numbered one whose key is this one's reversed key.
-  auto mix = [](uint64_t v) {  // splitmix64's finaliser
-    v = (v ^ (v >> 30)) * 0xbf58476d1ce4e5b9ull;
-    v = (v ^ (v >> 27)) * 0x94d049bb133111ebull;
-    return v ^ (v >> 31);
-  };
   std::vector<std::pair<uint64_t, int>> groups(static_cast<size_t>(n));
   for (int t = 0; t < n; t++) {
     uint64_t h = 0;
@@ -51,7 +47,7 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
       vec3f p = m.positions[size_t(m.tri_positions[3 * size_t(t) + size_t(i)])] + vec3f{0, 0, 0};  // (-0 as +0)
       uint32_t b[3];
       std::memcpy(b, &p, sizeof b);
-      h += mix((uint64_t(b[0]) << 32 | b[1]) ^ mix(b[2]));
+      h += mix64((uint64_t(b[0]) << 32 | b[1]) ^ mix64(b[2]));
     }
     groups[size_t(t)] = {h, t};
   }
