@@ -102,10 +102,20 @@ static void ear_clip(const std::vector<double>& x, const std::vector<double>& y,
   tris.insert(tris.end(), {prev[i], i, next[i]});
 }
 
+// The polygon corner with the smallest position (x, then y, then z; the first of equal ones): a choice that does
+// not depend on where the corner list starts or which way it runs.
+static int smallest_corner(const std::vector<vec3f>& p) {
+  auto less = [](vec3f a, vec3f b) { return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z; };
+  int m = 0;
+  for (int i = 1; i < int(p.size()); i++)
+    if (less(p[size_t(i)], p[size_t(m)])) m = i;
+  return m;
+}
+
 // Triangulates one polygon with corner positions p into n-2 triangles of local corner indices (winding kept).
 // Convex quads split along the shorter diagonal (as tinyobjloader does; of equal ones, the one through the smallest
-// corner), other convex polygons fan from
-// corner 0, concave ones are ear-clipped in the plane of their Newell normal.
+// corner), other convex polygons fan from their smallest corner, concave ones are ear-clipped in the plane of
+// their Newell normal.
 static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& st, std::vector<int>& tris) {
   int n = int(p.size());
   tris.clear();
@@ -140,16 +150,14 @@ static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& 
         // Equal diagonals (every rectangle): the one through the smallest corner (x, then y, then z), whatever the
         // corners' order, so that the two faces of a sheet written as a quad and its reverse are exact reversed twins
         // (scene.h): a ray then meets the face turned toward it.
-        auto less = [](vec3f a, vec3f b) { return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z; };
-        int m = 0;
-        for (int i = 1; i < 4; i++)
-          if (less(p[i], p[m])) m = i;
-        split02 = m % 2 == 0;
+        split02 = smallest_corner(p) % 2 == 0;
       }
       if (split02) return tris.assign({0, 1, 2, 0, 2, 3});
       return tris.assign({0, 1, 3, 1, 2, 3});
     }
-    for (int i = 1; i + 1 < n; i++) tris.insert(tris.end(), {0, i, i + 1});
+    // A fan from the smallest corner: a polygon and its reverse give exact reversed twins, as quads do.
+    int m = smallest_corner(p);
+    for (int i = 1; i + 1 < n; i++) tris.insert(tris.end(), {m, (m + i) % n, (m + i + 1) % n});
     return;
   }
   ear_clip(x, y, st, tris);

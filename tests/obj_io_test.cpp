@@ -126,6 +126,14 @@ TEST_CASE("a rectangle and its reverse are triangulated as exact reversed twins,
           triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(t)], true));
     CHECK(dot(s.tri_ng[size_t(t)], s.tri_ng[size_t(w)]) < 0);
   }
+  // A convex hexagon and its reverse, written from other first corners: fanned from their smallest corner, twins too.
+  auto hex = dir.write("h.obj", "v 0 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 0 2 0\nv -1 1 0\n"
+                                "f 3 4 5 6 1 2\nf 5 4 3 2 1 6\n");
+  mesh_data hm = load_obj(hex);
+  REQUIRE(triangle_count(hm) == 8);
+  scene_data hs = build_scene(hm, camera_params{}, sun_params{}, false, 1.0f);
+  REQUIRE(hs.tri_twin.size() == 8);
+  for (int t = 0; t < 8; t++) CHECK(hs.tri_twin[size_t(t)] != invalid_id);
   // A lone quad has no twin, and the column stays empty.
   scene_data lone = build_scene(load_obj(dir.write("l.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4\n")),
                                 camera_params{}, sun_params{}, false, 1.0f);
