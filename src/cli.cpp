@@ -429,7 +429,7 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (> 0, default 1)")
       ->check(positive_number)->group(bg);
   r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1, default 2)")
-      ->check(CLI::Range(1.000001, 1e9))->check(finite_number)->group(bg);
+      ->check(CLI::Range(1.000001, 1e9).description("FLOAT in (1 - 1e9]"))->check(finite_number)->group(bg);
   r->add_option("--bayes-oracle", o.bayes.oracle_spp,
                 "Oracle mode: learn for this many spp first (own seed, not timed), then freeze the statistics")
       ->check(CLI::Range(0, 1 << 30))->group(bg);
@@ -528,6 +528,9 @@ void add_compare_command(CLI::App& app, compare_options& o) {
   c->add_option("--runs", o.runs, "Runs per sampler, seeds base, base+1, ... (default 1)")->check(CLI::Range(1, 10000));
   c->add_option("--reference-note", o.reference_note, "How the reference was made, for summary.md");
   add_render_options(c, o.render);
+  // (compare has no scene default: every sampler renders the same given budget)
+  c->get_option("--spp")->description("Samples per pixel of every render (this or --time is required)");
+  c->get_option("--time")->description("Seconds per render, whole passes (this or --spp is required)");
 }
 
 int run_compare_command(const compare_options& o) {
