@@ -112,28 +112,26 @@ TEST_CASE("a rectangle and its reverse are triangulated as exact reversed twins,
   // Equal diagonals: the split went by corner order (1-3), so a quad and its reverse were split along different
   // diagonals and their faces overlapped without being twins (a review: a two-faced lamp written as quads).
   temp_dir dir;
-  auto obj = dir.write("q.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
-                                "f 1 2 3 4\nf 4 3 2 1\nf 2 3 4 1\nf 1 4 3 2\nf 3 2 1 4\n");
-  mesh_data m = load_obj(obj);
-  REQUIRE(triangle_count(m) == 10);
-  scene_data s = build_scene(m, camera_params{}, sun_params{}, false, 1.0f);
-  REQUIRE(s.tri_twin.size() == 10);
-  for (int t = 0; t < 10; t++) {
-    INFO("triangle " << t);
-    int w = s.tri_twin[size_t(t)];
-    REQUIRE(w != invalid_id);
-    CHECK(triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(w)]) ==
-          triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(t)], true));
-    CHECK(dot(s.tri_ng[size_t(t)], s.tri_ng[size_t(w)]) < 0);
-  }
+  // Every triangle of the file has a reversed twin: the same corners in the opposite order, facing the other way.
+  auto check_all_twins = [&](const std::string& name, const std::string& text, int triangles) {
+    INFO(name);
+    mesh_data m = load_obj(dir.write(name, text));
+    REQUIRE(triangle_count(m) == triangles);
+    scene_data s = build_scene(m, camera_params{}, sun_params{}, false, 1.0f);
+    REQUIRE(s.tri_twin.size() == size_t(triangles));
+    for (int t = 0; t < triangles; t++) {
+      INFO("triangle " << t);
+      int w = s.tri_twin[size_t(t)];
+      REQUIRE(w != invalid_id);
+      CHECK(triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(w)]) ==
+            triangle_corner_key(m.positions, &m.tri_positions[3 * size_t(t)], true));
+      CHECK(dot(s.tri_ng[size_t(t)], s.tri_ng[size_t(w)]) < 0);
+    }
+  };
+  check_all_twins("q.obj",
+                  "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4\nf 4 3 2 1\nf 2 3 4 1\nf 1 4 3 2\nf 3 2 1 4\n", 10);
   // A convex hexagon and its reverse, written from other first corners: fanned from their smallest corner, twins too.
-  auto hex = dir.write("h.obj", "v 0 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 0 2 0\nv -1 1 0\n"
-                                "f 3 4 5 6 1 2\nf 5 4 3 2 1 6\n");
-  mesh_data hm = load_obj(hex);
-  REQUIRE(triangle_count(hm) == 8);
-  scene_data hs = build_scene(hm, camera_params{}, sun_params{}, false, 1.0f);
-  REQUIRE(hs.tri_twin.size() == 8);
-  for (int t = 0; t < 8; t++) CHECK(hs.tri_twin[size_t(t)] != invalid_id);
+  check_all_twins("h.obj", "v 0 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 0 2 0\nv -1 1 0\nf 3 4 5 6 1 2\nf 5 4 3 2 1 6\n", 8);
   // A lone quad has no twin, and the column stays empty.
   scene_data lone = build_scene(load_obj(dir.write("l.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4\n")),
                                 camera_params{}, sun_params{}, false, 1.0f);
