@@ -20,6 +20,18 @@ std::string base_args(const std::string& sampler) {
          " --width 40 --height 30 --spp 27 --quiet";  // 27: the end of a scheduled pass (see pass_size)
 }
 
+// The Cornell box, direct, rendered with `sampler` at w x h (no spp: each use gives its own).
+std::string cornell_args(const std::string& sampler, int w, int h) {
+  return "render " + source_path("data/cornell/direct.json") + " --sampler " + sampler + " --width " +
+         std::to_string(w) + " --height " + std::to_string(h) + " --quiet";
+}
+
+// Renders `args` to `spp` with a checkpoint at ck (the image to dir/a.pfm).
+void render_checkpoint(const std::string& args, int spp, const temp_dir& dir, const std::string& ck) {
+  REQUIRE(run_bayeslight(args + " --spp " + std::to_string(spp) + " -o " + (dir / "a.pfm") + " --checkpoint " + ck)
+              .status == 0);
+}
+
 }  // namespace
 
 TEST_CASE("interrupted and killed renders resume to the same bytes", "[checkpoint]") {
@@ -115,9 +127,8 @@ TEST_CASE("a checkpoint resumed for one spp more after a pass of several goes on
   // after one of several, and the resumed render crashed (exit 139) at its first pixel (a review).
   temp_dir d;
   std::string ck = d / "ck.bin";
-  std::string args =
-      "render " + source_path("data/cornell/direct.json") + " --sampler bayes --width 80 --height 60 --quiet";
-  REQUIRE(run_bayeslight(args + " --spp 10 -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
+  std::string args = cornell_args("bayes", 80, 60);
+  render_checkpoint(args, 10, d, ck);
   auto resumed = run_bayeslight(args + " --spp 11 -o " + (d / "resumed.pfm") + " --resume " + ck);
   INFO(resumed.output);
   REQUIRE(resumed.status == 0);
@@ -266,9 +277,8 @@ TEST_CASE("resuming to fewer spp than a checkpoint holds says where the smaller 
   // Without --spp the count is the scene's render.spp; the message said "--spp 64", an option never given (a review).
   temp_dir d;
   std::string ck = d / "ck.bin";
-  std::string args =
-      "render " + source_path("data/cornell/direct.json") + " --sampler power --width 16 --height 12 --quiet";
-  REQUIRE(run_bayeslight(args + " --spp 100 -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
+  std::string args = cornell_args("power", 16, 12);
+  render_checkpoint(args, 100, d, ck);
   auto given = run_bayeslight(args + " --spp 50 -o " + (d / "b.pfm") + " --resume " + ck);
   INFO(given.output);
   CHECK(given.status == 2);
