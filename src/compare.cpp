@@ -153,9 +153,10 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
     double den = data.equal_time ? st.relmse : st.relmse * st.seconds;
     st.speedup = den > 0 && std::isfinite(num) && std::isfinite(den) ? num / den : NAN;
     // The first sampler reaches its own relMSE at its end by definition: at the budget at equal time (its curve can
-    // rise again in the pass after it, heavy-tailed as relMSE is), at its mean time at equal spp (where its curve's
-    // last point, the mean of sums, can differ from the sum of means in the last bit and miss it).
-    if (&st == &all[0]) st.time_to_target = data.equal_time ? data.time_budget : st.seconds;
+    // rise again in the pass after it, heavy-tailed as relMSE is), or at its last pass when a signal stopped it
+    // sooner; at its mean time at equal spp (where its curve's last point, the mean of sums, can differ from the sum
+    // of means in the last bit and miss it).
+    if (&st == &all[0]) st.time_to_target = data.equal_time ? std::min(data.time_budget, st.seconds) : st.seconds;
     else st.time_to_target = time_to_reach(st.curve_seconds, st.curve_relmse, base.relmse);
   }
   return all;

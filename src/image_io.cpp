@@ -185,14 +185,21 @@ static float exr_sample(const unsigned char* p, int pixel_type, size_t i) {
 // size (DecompressPiz, tinyexr.h:3095-3116); with the padding those reads stay inside our buffer.
 static constexpr size_t exr_read_padding = 64 * 1024;
 
-// The first non-empty "type" attribute of the EXR header at mem (after the 8-byte magic and version) that is not
-// "scanlineimage", read as tinyexr's ParseEXRHeader reads attributes ("" when there is none, or the header is
-// malformed: tinyexr then fails on its own). tinyexr 1.0.1 asserts on type values that disagree with the version
-// flags (ConvertHeader, tinyexr.h:4536-4548), and Debian builds it with assertions on: an unknown type aborts the
-// process. Every type attribute counts, not only the last: fuzzing found headers with two, the first one bad,
-// that still reached the assertion.
-static std::string exr_type_attribute(const unsigned char* mem, size_t size) {
-  std::string type;
+// What read_exr checks in the EXR header at mem (after the 8-byte magic and version) before tinyexr parses it,
+// reading attributes as tinyexr's ParseEXRHeader does (on a malformed header both stay empty and tinyexr then
+// fails on its own):
+// - type: the first non-empty "type" attribute that is not "scanlineimage" ("" when there is none). tinyexr 1.0.1
+//   asserts on type values that disagree with the version flags (ConvertHeader, tinyexr.h:4536-4548), and Debian
+//   builds it with assertions on: an unknown type aborts the process. Every type attribute counts, not only the
+//   last: fuzzing found headers with two, the first one bad, that still reached the assertion.
+// - compression: the name of a valid OpenEXR compression tinyexr cannot decode (PXR24, B44, B44A, DWAA, DWAB),
+//   which it would report as an "unknown" type of a malformed header ("" when none).
+struct exr_precheck {
+  std::string type, compression;
+};
+static exr_precheck exr_header_precheck(const unsigned char* mem, size_t size) {
+  static const char* const undecodable[] = {"PXR24", "B44", "B44A", "DWAA", "DWAB"};  // codes 5-9
+  exr_precheck out;
   size_t pos = 8;
   while (pos < size && mem[pos] != 0) {
     const char* p = reinterpret_cast<const char*>(mem + pos);
@@ -209,16 +216,20 @@ static std::string exr_type_attribute(const unsigned char* mem, size_t size) {
     const char* data = p + head + 4;
     if (std::strcmp(p, "type") == 0 && len > 0 && data[0] != 0) {
       std::string t(data, strnlen(data, len));
-      if (t != "scanlineimage" && type.empty()) type = t;
+      if (t != "scanlineimage" && out.type.empty()) out.type = t;
+    }
+    if (std::strcmp(p, "compression") == 0 && len > 0 && out.compression.empty()) {
+      unsigned code = static_cast<unsigned char>(data[0]);
+      if (code >= 5 && code <= 9) out.compression = undecodable[code - 5];
     }
     pos += head + 4 + len;
   }
-  for (char& c : type) c = c >= 32 && c < 127 ? c : '?';  // for the message
-  return type;
+  for (char& c : out.type) c = c >= 32 && c < 127 ? c : '?';  // for the message
+  return out;
 }
 
-// Reads R, G, B of a single-part scanline EXR (a single-channel file is replicated to grey); alpha and other
-// channels are ignored. Tiled files are rejected: tinyexr's tiled error paths free memory unreliably.
+// Reads R, G, B of a single-part scanline EXR (without them Y, or a file's only channel, is replicated to grey);
+// alpha and other channels are ignored. Tiled files are rejected: tinyexr's tiled error paths free memory unreliably.
 static image_data read_exr(const std::string& path) {
   std::string bytes = read_file(path);
   const size_t size = bytes.size();
@@ -229,9 +240,13 @@ static image_data read_exr(const std::string& path) {
     throw input_error(path, "not an OpenEXR file");
   if (version.multipart || version.non_image || version.tiled)
     throw input_error(path, "tiled, multi-part and deep OpenEXR files are not supported (write scanline RGB)");
-  const std::string type = exr_type_attribute(mem, size);
-  if (!type.empty() && type != "scanlineimage")
-    throw input_error(path, "OpenEXR image type \"" + type.substr(0, 40) + "\" is not supported (write scanline RGB)");
+  const exr_precheck pre = exr_header_precheck(mem, size);
+  if (!pre.type.empty())
+    throw input_error(path,
+                      "OpenEXR image type \"" + pre.type.substr(0, 40) + "\" is not supported (write scanline RGB)");
+  if (!pre.compression.empty())
+    throw input_error(path, "OpenEXR compression " + pre.compression +
+                                " is not supported (save it with ZIP, PIZ, RLE or no compression)");
   exr_file_data exr;
   const char* err = nullptr;
   if (ParseEXRHeaderFromMemory(&exr.header, &version, mem, size, &err) != TINYEXR_SUCCESS)
@@ -239,12 +254,16 @@ static image_data read_exr(const std::string& path) {
   const EXRHeader& h = exr.header;
   int rgb[3] = {find_channel(h, "R"), find_channel(h, "G"), find_channel(h, "B")};
   if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
-    if (h.num_channels != 1) {
+    const int y = find_channel(h, "Y");  // luminance (with alpha or others): grey
+    if (y >= 0) {
+      rgb[0] = rgb[1] = rgb[2] = y;
+    } else if (h.num_channels != 1) {
       std::string names;
       for (int c = 0; c < h.num_channels && c < 8; ++c) names += std::string(c ? ", " : "") + h.channels[c].name;
-      throw input_error(path, "OpenEXR file has no R, G and B channels (found: " + names + ")");
+      throw input_error(path, "OpenEXR file has no R, G and B or Y channels (found: " + names + ")");
+    } else {
+      rgb[0] = rgb[1] = rgb[2] = 0;  // one channel (A, ...): grey
     }
-    rgb[0] = rgb[1] = rgb[2] = 0;  // one channel (Y, A, ...): grey
   }
   for (int c : rgb)
     if (h.channels[c].x_sampling != 1 || h.channels[c].y_sampling != 1)
@@ -269,8 +288,16 @@ static image_data read_exr(const std::string& path) {
   img.width = im.width;
   img.height = im.height;
   img.pixels.resize(size_t(im.width) * size_t(im.height) * 3);
-  for (size_t i = 0; i < size_t(im.width) * size_t(im.height); ++i)
-    for (int k = 0; k < 3; ++k) img.pixels[i * 3 + k] = exr_sample(im.images[rgb[k]], h.pixel_types[rgb[k]], i);
+  // tinyexr 1.0.1 stores the rows of a file whose line order is not INCREASING_Y bottom up (tinyexr.h:3994 and its
+  // siblings), yet every chunk carries its own y: the line order only says in which order the chunks were written.
+  const bool flipped = h.line_order != 0;
+  const size_t w = size_t(im.width), rows = size_t(im.height);
+  for (size_t y = 0; y < rows; ++y) {
+    const size_t src = (flipped ? rows - 1 - y : y) * w;
+    for (size_t x = 0; x < w; ++x)
+      for (int k = 0; k < 3; ++k)
+        img.pixels[(y * w + x) * 3 + size_t(k)] = exr_sample(im.images[rgb[k]], h.pixel_types[rgb[k]], src + x);
+  }
   return img;
 }
 

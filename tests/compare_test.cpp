@@ -457,6 +457,32 @@ TEST_CASE("at equal spp the first sampler reaches its own mean relMSE at its own
   CHECK(st[1].time_to_target == Approx(2.0));  // (its only point is below the target: reached at its first pass)
 }
 
+TEST_CASE("an interrupted equal-time comparison times the first sampler at its last pass, not at the budget",
+          "[compare]") {
+  compare_data d;
+  d.samplers.resize(1);
+  d.equal_time = true;
+  d.time_budget = 3;
+  d.signal = 2;  // SIGINT at 1.5 s: the run's passes end at 0.5, 1.0 and 1.48 s
+  compare_run run;
+  run.spp = 3;
+  for (double t : {0.5, 1.0, 1.48}) {
+    pass_record p;
+    p.seconds = t;
+    p.has_error = true;
+    p.error.relmse = 0.1 / t;
+    run.log.push_back(p);
+  }
+  d.samplers[0].runs.push_back(run);
+  std::vector<compare_stats> st = comparison_stats(d);
+  REQUIRE(st.size() == 1);
+  CHECK(st[0].relmse == Approx(0.1 / 1.48));
+  CHECK(st[0].time_to_target == Approx(1.48));
+  d.signal = 0;  // a complete run ends with the first pass past the budget: reached at the budget
+  d.samplers[0].runs[0].log.back().seconds = 3.2;
+  CHECK(comparison_stats(d)[0].time_to_target == Approx(3.0));
+}
+
 TEST_CASE("the plot writer escapes labels and draws one path per series", "[compare]") {
   plot_series a{"a<b>&\"c\"", {0.01, 0.1, 1}, {1, 0.1, 0.01}};
   plot_series b{"second", {0.0, -1, 0.5, 2}, {1, 1, 0.2, NAN}};  // only (0.5, 0.2) can be placed on log axes

@@ -1,6 +1,7 @@
 // Tests of image_io: bit-exact .exr and .pfm round trips (negative, huge, tiny, signed zero, inf, NaN), PNG
 // quantisation within half a code value, hand-made greyscale and big-endian PFMs, half-float and one-channel
-// EXRs from tinyexr, and malformed or truncated files rejected with an input_error naming the file.
+// EXRs from tinyexr, hand-made EXRs in any line order, grey with alpha and of undecodable compressions, and
+// malformed or truncated files rejected with an input_error naming the file.
 #include "errors.h"
 #include "file_io.h"
 #include "image_io.h"
@@ -170,6 +171,92 @@ TEST_CASE("half-float and one-channel EXR files from tinyexr are read", "[image_
   const float grey[2] = {0.75f, 8.0f};  // SaveEXR writes one component as channel "A"
   REQUIRE(SaveEXR(grey, 1, 2, 1, 0, (dir / "grey.exr").c_str(), &err) == TINYEXR_SUCCESS);
   CHECK(read_image(dir / "grey.exr").pixels == std::vector<float>{0.75f, 0.75f, 0.75f, 8, 8, 8});
+}
+
+// An uncompressed scanline EXR (OpenEXR 2 layout) of float channels written by hand: planes[c] holds channel
+// names[c]'s w x h values, top row first; names in the alphabetical order OpenEXR stores them. line_order 1
+// (DECREASING_Y) writes the chunks from the bottom row up; the offset table stays in y order. compression is the
+// header's code (the data stay uncompressed: only a reader's check of the header can use it).
+static std::string handmade_exr(int w, int h, const std::vector<std::string>& names,
+                                const std::vector<std::vector<float>>& planes, int line_order, int compression = 0) {
+  auto u32 = [](uint32_t v) { return std::string{char(v), char(v >> 8), char(v >> 16), char(v >> 24)}; };
+  auto attr = [&](const std::string& name, const std::string& type, const std::string& data) {
+    return name + '\0' + type + '\0' + u32(uint32_t(data.size())) + data;
+  };
+  std::string channels;
+  for (const std::string& n : names) channels += n + '\0' + u32(2) + u32(0) + u32(1) + u32(1);  // FLOAT, linear 0
+  channels += '\0';
+  const std::string box = u32(0) + u32(0) + u32(uint32_t(w - 1)) + u32(uint32_t(h - 1));
+  std::string header = u32(20000630) + u32(2) + attr("channels", "chlist", channels) +
+                       attr("compression", "compression", std::string(1, char(compression))) +
+                       attr("dataWindow", "box2i", box) + attr("displayWindow", "box2i", box) +
+                       attr("lineOrder", "lineOrder", std::string(1, char(line_order))) +
+                       attr("pixelAspectRatio", "float", float_bytes(1, true)) +
+                       attr("screenWindowCenter", "v2f", float_bytes(0, true) + float_bytes(0, true)) +
+                       attr("screenWindowWidth", "float", float_bytes(1, true)) + '\0';
+  std::vector<std::string> chunks(static_cast<size_t>(h));
+  for (int y = 0; y < h; ++y) {
+    std::string data;
+    for (const auto& plane : planes)
+      for (int x = 0; x < w; ++x) data += float_bytes(plane[size_t(y * w + x)], true);
+    chunks[size_t(y)] = u32(uint32_t(y)) + u32(uint32_t(data.size())) + data;
+  }
+  std::vector<uint64_t> offsets(static_cast<size_t>(h));
+  std::string body;
+  uint64_t at = header.size() + 8 * size_t(h);
+  for (int k = 0; k < h; ++k) {
+    const int y = line_order == 0 ? k : h - 1 - k;
+    offsets[size_t(y)] = at + body.size();
+    body += chunks[size_t(y)];
+  }
+  std::string table;
+  for (uint64_t o : offsets) table += u32(uint32_t(o)) + u32(uint32_t(o >> 32));
+  return header + table + body;
+}
+
+TEST_CASE("EXR files in any line order, and grey ones with alpha, read as written", "[image_io]") {
+  test::temp_dir dir;
+  const int w = 3, h = 4;
+  std::vector<std::vector<float>> bgr(3, std::vector<float>(size_t(w * h)));
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < w * h; ++i) bgr[size_t(c)][size_t(i)] = float(100 * c + i);  // B, G, R planes
+  std::vector<float> expected;
+  for (int i = 0; i < w * h; ++i)
+    for (int c = 2; c >= 0; --c) expected.push_back(bgr[size_t(c)][size_t(i)]);
+  for (int order : {0, 1, 2}) {  // INCREASING_Y, DECREASING_Y, RANDOM_Y (chunks written bottom up)
+    INFO("line order " << order);
+    const std::string path = dir / ("order" + std::to_string(order) + ".exr");
+    write_file_atomic(path, handmade_exr(w, h, {"B", "G", "R"}, bgr, order));
+    image_data img = read_image(path);
+    CHECK(img.width == w);
+    CHECK(img.height == h);
+    CHECK(img.pixels == expected);
+  }
+  // Luminance with alpha: Y is the grey, whatever the other channels.
+  std::vector<float> alpha(size_t(w * h), 0.5f), lum(size_t(w * h));
+  for (int i = 0; i < w * h; ++i) lum[size_t(i)] = 0.25f * float(i);
+  write_file_atomic(dir / "ya.exr", handmade_exr(w, h, {"A", "Y"}, {alpha, lum}, 1));
+  image_data ya = read_image(dir / "ya.exr");
+  REQUIRE(ya.pixels.size() == size_t(w * h * 3));
+  for (int i = 0; i < w * h * 3; ++i) CHECK(ya.pixels[size_t(i)] == lum[size_t(i / 3)]);
+  // Two channels, neither R, G, B nor Y: refused, naming what the file has.
+  write_file_atomic(dir / "uv.exr", handmade_exr(w, h, {"U", "V"}, {alpha, lum}, 0));
+  CHECK_THAT(read_error(dir / "uv.exr"), Catch::Contains("found: U, V"));
+}
+
+TEST_CASE("EXR compressions tinyexr cannot decode are named, not called malformed", "[image_io]") {
+  test::temp_dir dir;
+  std::vector<std::vector<float>> grey(1, std::vector<float>(4, 1.0f));
+  const char* names[] = {"PXR24", "B44", "B44A", "DWAA", "DWAB"};
+  for (int code = 5; code <= 9; ++code) {
+    const std::string path = dir / (std::string(names[code - 5]) + ".exr");
+    write_file_atomic(path, handmade_exr(2, 2, {"Y"}, grey, 0, code));
+    const std::string msg = read_error(path);
+    CHECK_THAT(msg, Catch::Contains(std::string("compression ") + names[code - 5] + " is not supported"));
+    CHECK_THAT(msg, !Catch::Contains("malformed"));
+  }
+  write_file_atomic(dir / "none.exr", handmade_exr(2, 2, {"Y"}, grey, 0, 0));
+  CHECK(read_image(dir / "none.exr").pixels == std::vector<float>(12, 1.0f));
 }
 
 TEST_CASE("PNG output is sRGB within half a code value of the exact encoding", "[image_io]") {
