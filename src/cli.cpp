@@ -323,17 +323,6 @@ const CLI::Validator finite_number(
 const CLI::Validator file_name(
     [](std::string& text) -> std::string { return text.empty() ? "an empty file name" : std::string(); }, "");
 
-// A finite number above 0 (CLI::PositiveNumber's message would print the largest double in full).
-const CLI::Validator positive_number(
-    [](std::string& text) -> std::string {
-      char* end = nullptr;
-      double v = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || !(v > 0))
-        return "Value " + text + " is not a positive finite number";
-      return {};
-    },
-    "");
-
 // The options `render` and `compare` share: spp or time, size, depth, threads, seed, quiet, sampler options.
 void add_render_options(CLI::App* r, render_options& o) {
   auto* spp = r->add_option("--spp", o.spp, "Samples per pixel (default: the scene's render.spp)")
@@ -426,8 +415,10 @@ void add_render_options(CLI::App* r, render_options& o) {
       ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
   r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (1e-6 to 1e6, default 0.03)")
       ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
-  r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (> 0, default 1)")
-      ->check(positive_number)->group(bg);
+  // (kappa0 and c at most 1e6: beyond, kappa0 n1 and c mu0^2 of bright lights overflow, and every weight met the
+  // ceiling of the fold, max_pair_weight, so that the PMF ignored the bound and p0 alike.)
+  r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (1e-6 to 1e6, default 1)")
+      ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
   r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1, default 2)")
       ->check(CLI::Range(1.000001, 1e9).description("FLOAT in (1 - 1e9]"))->check(finite_number)->group(bg);
   r->add_option("--bayes-oracle", o.bayes.oracle_spp,
@@ -445,8 +436,9 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "cannot pay for its own cost (default 1.25; doubled unless --independent-samples, as the estimate "
                 "assumes independent samples and stratification helps power sampling more; 0 = never)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
-  r->add_option("--bayes-c", o.bayes.c, "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (> 0, default 0.3)")
-      ->check(positive_number)->group(bg);
+  r->add_option("--bayes-c", o.bayes.c,
+                "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (1e-6 to 1e6, default 0.3)")
+      ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
 }
 
 void add_render_command(CLI::App& app, render_options& o) {

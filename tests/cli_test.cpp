@@ -182,6 +182,11 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --bayes-b0 1e-300", "--bayes-b0"},
       {"render " + s.json + " --bayes-a0 1e-7", "--bayes-a0"},
       {"render " + s.json + " --bayes-alpha0 nan", "--bayes-alpha0"},
+      // Prior strengths so large that every pair's weight met the fold's ceiling (the PMF ignored bound and p0).
+      {"render " + s.json + " --bayes-c 1e300", "--bayes-c"},
+      {"render " + s.json + " --bayes-c 2e6", "--bayes-c"},
+      {"render " + s.json + " --bayes-kappa0 1e308", "--bayes-kappa0"},
+      {"render " + s.json + " --bayes-kappa0 0", "--bayes-kappa0"},
       {"render " + s.json + " --frame-decay nan", "--frame-decay"},
       {"render " + s.json + " --checkpoint-every nan", "--checkpoint-every"},
       // Seeds: digits within 64 bits (a conversion would wrap -1 and saturate 2^64).
