@@ -438,9 +438,11 @@ TEST_CASE("lazily refolded bayes weights stay within the refold tolerance of an 
     CHECK(checked > 100);
     if (tol == 0) CHECK(differ == 0);
     // W is proportional to sqrt(p1), and a child's p1 is at most 2 tol (relative) from its exact value. Under the mean
-    // hierarchy W = sqrt(p1 Q(mu)) also depends on the prior mean mu, the parent's mean (stale by at most tol,
-    // relative), with Q at most about quadratic in mu: W moves by about the mean's relative change at most.
-    CHECK(worst <= (means ? 1 + tol : 1.0) * std::sqrt(1 + 2 * tol) - 1 + 1e-5);
+    // hierarchy W = sqrt(p1 Q(mu)) also depends on the prior mean mu, with Q at most about quadratic in mu: W moves by
+    // about the mean's relative change at most. A child holds the parent's mean of when it was last folded, and both
+    // that and the parent's mean now lie within tol of the parent's reference (k_folded): 2 tol apart at most (the
+    // bound was 1 + tol here until a review found 11.7 % on the hall's pairs at tol 0.05).
+    CHECK(worst <= (means ? 1 + 2 * tol : 1.0) * std::sqrt(1 + 2 * tol) - 1 + 1e-5);
     if (tol >= 0.2) CHECK(differ > 0);  // the laziness is real: some weights were not refolded
   }
 }
