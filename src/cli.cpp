@@ -77,7 +77,7 @@ struct diff_options {
 // Options of `compare` (render.sampler, render.outputs and render.log are unused).
 struct compare_options {
   render_options render;
-  std::vector<std::string> samplers;
+  std::string samplers;  // comma-separated
   std::string out;
   int runs = 1;
   std::string reference_note;
@@ -514,8 +514,9 @@ void add_compare_command(CLI::App& app, compare_options& o) {
   c->add_option("--reference", o.render.reference, "Reference .exr/.pfm of the render's size")
       ->required()
       ->check(file_name);
+  // (One string, split here: a vector option would show as "TEXT ..." in the help, as if it took several words.)
   c->add_option("--samplers", o.samplers, "Comma-separated samplers, the first is the baseline: " + sampler_names())
-      ->required()->delimiter(',')->allow_extra_args(false);
+      ->required()->type_name("NAME,NAME,...");
   c->add_option("--out", o.out, "Output directory (created if missing)")->required();
   c->add_option("--runs", o.runs, "Runs per sampler, seeds base, base+1, ... (default 1)")->check(CLI::Range(1, 10000));
   c->add_option("--reference-note", o.reference_note, "How the reference was made, for summary.md");
@@ -528,7 +529,15 @@ void add_compare_command(CLI::App& app, compare_options& o) {
 int run_compare_command(const compare_options& o) {
   install_interrupt_handlers();  // (a signal while the scene loads ends the command once it has loaded)
   compare_params cp;
-  for (const std::string& name : o.samplers) {
+  std::vector<std::string> names;
+  for (size_t b = 0;;) {
+    size_t e = o.samplers.find(',', b);
+    names.push_back(o.samplers.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  for (const std::string& name : names) {
+    if (name.empty()) throw usage_error("--samplers \"" + o.samplers + "\" has an empty name (e.g. bound,bayes)");
     sampler_kind kind;
     if (!parse_sampler_kind(name, kind))
       throw usage_error("unknown sampler \"" + name + "\" (valid: " + sampler_names() + ")");

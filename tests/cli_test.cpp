@@ -562,6 +562,11 @@ TEST_CASE("help lists the samplers and options", "[cli]") {
   for (const char* s : {"--sampler", "--spp", "--time", "--max-depth", "--threads", "--seed", "--reference", "--log",
                         "--quiet", "bayes"})
     CHECK(r.output.find(s) != std::string::npos);
+  // compare's --samplers takes one comma-separated word (not "TEXT ...", which reads as several).
+  auto c = run_bayeslight("compare --help");
+  CHECK(c.status == 0);
+  CHECK(c.output.find("--samplers NAME,NAME,...") != std::string::npos);
+  CHECK(c.output.find("TEXT ...") == std::string::npos);
 }
 
 TEST_CASE("an interrupted render writes the completed passes and exits 130 or 143", "[cli]") {
