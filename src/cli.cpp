@@ -151,7 +151,7 @@ image_data load_reference(const std::string& path, const render_params& params) 
 }
 
 int run_render(const render_options& o) {
-  install_interrupt_handlers();  // (a signal while the scene loads ends the command once it has loaded)
+  install_interrupt_handlers();  // (a signal while the scene loads ends the command at once)
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
@@ -527,7 +527,7 @@ void add_compare_command(CLI::App& app, compare_options& o) {
 }
 
 int run_compare_command(const compare_options& o) {
-  install_interrupt_handlers();  // (a signal while the scene loads ends the command once it has loaded)
+  install_interrupt_handlers();  // (a signal while the scene loads ends the command at once)
   compare_params cp;
   std::vector<std::string> names;
   for (size_t b = 0;;) {

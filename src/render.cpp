@@ -15,14 +15,28 @@
 #include <pthread.h>
 #include <thread>
 #include <type_traits>
+#include <unistd.h>
 
 namespace bl {
 
 namespace {
 
 std::atomic<int> g_signal{0};
+// From install_interrupt_handlers until interrupted_before_render: loading the scene and setting up, when nothing has
+// been written yet, and a loader deep in a large file would notice a request only once it is done.
+std::atomic<bool> g_setup{false};
 
-extern "C" void on_interrupt(int sig) { g_signal.store(sig); }
+extern "C" void on_interrupt(int sig) {
+  if (g_setup.load()) {
+    // Async-signal-safe: write(2) and _exit(2) only.
+    static const char term[] = "bayeslight: interrupted (SIGTERM) while loading the scene; nothing written\n";
+    static const char intr[] = "bayeslight: interrupted (SIGINT) while loading the scene; nothing written\n";
+    ssize_t ignored = sig == SIGTERM ? write(2, term, sizeof term - 1) : write(2, intr, sizeof intr - 1);
+    (void)ignored;
+    _exit(128 + sig);
+  }
+  g_signal.store(sig);
+}
 
 using clock_type = std::chrono::steady_clock;
 double seconds_since(clock_type::time_point t) {
@@ -370,6 +384,7 @@ image_data film_image(const render_result& r) {
 }
 
 void install_interrupt_handlers() {
+  g_setup.store(true);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
   // A process started with them blocked (a launcher's mask is inherited) could not be interrupted at all; one that
@@ -383,6 +398,7 @@ void install_interrupt_handlers() {
 int interrupt_signal() { return g_signal.load(); }
 void reset_interrupt() { g_signal.store(0); }
 int interrupted_before_render() {
+  g_setup.store(false);  // from here a signal asks the render to stop after its pass
   int sig = g_signal.load();
   if (sig == 0) return 0;
   std::fprintf(stderr, "bayeslight: interrupted (%s) while loading the scene; nothing written\n",

@@ -100,13 +100,15 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
 // The film's weighted mean image, negative values written as zero (zero when no sample completed).
 image_data film_image(const render_result& r);
 
-// Installs SIGINT/SIGTERM handlers that request the render to stop; returns the signal seen (0: none).
+// Installs SIGINT/SIGTERM handlers. Until interrupted_before_render is called (setting up: nothing written yet) a
+// signal ends the process at once with "interrupted (SIG...) while loading the scene; nothing written" and 128 +
+// signal; after it, a signal requests the render to stop after the current pass.
 void install_interrupt_handlers();
 int interrupt_signal();
 // Clears a pending interrupt request (tests).
 void reset_interrupt();
-// For a signal that arrived before the first pass (the handlers are installed before the scene loads): says so on
-// stderr and returns the exit status, 128 + signal; 0 when none did.
+// Ends the set-up phase (see install_interrupt_handlers). A signal noted before it (not while setting up, which
+// exits at once) is reported as one during loading: the exit status 128 + signal; else 0.
 int interrupted_before_render();
 
 }  // namespace bl

@@ -1,6 +1,7 @@
 // Tests of the command line as users drive it: exit statuses (SPEC.md section 4), messages that name the
 // problem (file and line), no output file left behind by a failure, the diff command, and the per-pass log.
 #include "image_io.h"
+#include "render.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
@@ -632,6 +633,50 @@ TEST_CASE("an interrupted profile says so and prints no report", "[cli]") {
   CHECK(out.find("interrupted during the plain render") != std::string::npos);
   CHECK(out.find("nan") == std::string::npos);
   CHECK(out.find("stage") == std::string::npos);
+}
+
+TEST_CASE("a signal during set-up ends the process at once; after it, it only asks the render to stop", "[cli]") {
+  // A loader deep in a large OBJ never looks at the request: the handler itself ends the process while setting up
+  // (before, the request waited for the load to finish). The child stands for a load that would take 20 s.
+  for (int sig : {SIGINT, SIGTERM}) {
+    int err[2];
+    REQUIRE(pipe(err) == 0);
+    pid_t pid = fork();
+    if (pid == 0) {
+      dup2(err[1], 2);
+      close(err[0]);
+      bl::install_interrupt_handlers();
+      kill(getpid(), sig);
+      sleep(20);  // "loading"
+      _exit(0);
+    }
+    close(err[1]);
+    REQUIRE(pid > 0);
+    std::string text;
+    char buf[256];
+    for (ssize_t n; (n = read(err[0], buf, sizeof buf)) > 0;) text.append(buf, size_t(n));
+    close(err[0]);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    INFO("signal " << sig << ", wait status " << status << ", stderr: " << text);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 128 + sig);
+    CHECK(text == std::string("bayeslight: interrupted (") + (sig == SIGINT ? "SIGINT" : "SIGTERM") +
+                      ") while loading the scene; nothing written\n");
+  }
+  // After set-up the same signal is only noted, for the render loop to stop at the end of its pass.
+  pid_t pid = fork();
+  if (pid == 0) {
+    bl::install_interrupt_handlers();
+    if (bl::interrupted_before_render() != 0) _exit(1);
+    kill(getpid(), SIGINT);
+    _exit(bl::interrupt_signal() == SIGINT ? 0 : 2);
+  }
+  REQUIRE(pid > 0);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
 }
 
 TEST_CASE("a signal while the scene loads ends the render with exit 130 or 143, not by the signal", "[cli]") {

@@ -161,6 +161,7 @@ TEST_CASE("an oracle interrupted while it learns leaves no frozen model behind",
     for (const pair_moments& m : s.stats.m) observations += m.n0 + m.n1;
   };
   install_interrupt_handlers();
+  REQUIRE(interrupted_before_render() == 0);  // set-up over (until then a signal would end the process at once)
   std::raise(SIGINT);  // the handler only notes it: the oracle's first pass stops, and so does the render
   render_result r = render(b->scene, b->bvh, b->lights, p);
   reset_interrupt();
