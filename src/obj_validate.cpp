@@ -1,9 +1,10 @@
 // obj_validate: line-by-line checks of OBJ and MTL text, written to accept only what tinyobjloader parses
 // exactly as we read it (its number grammar, its index forms) and to name file and line on every rejection.
 // Invariants: lines end at \n, \r\n or a lone \r (a statement ending in a backslash continues on the next); a
-// token starting with '#' starts a comment; tokens are split at spaces, tabs, \v and \f; numbers are finite
-// floats of at most max_number_chars characters and decimal exponent at most 300 in magnitude; every index refers
-// to an element defined earlier in the file.
+// token starting with '#' starts a comment (in material and texture names only a lone '#': "Material #1" is a
+// name); tokens are split at spaces, tabs, \v and \f; numbers are finite floats of at most max_number_chars
+// characters and decimal exponent at most 300 (any negative one: 1e-310 is 0); every index refers to an element
+// defined earlier in the file.
 #include "obj_validate.h"
 
 #include "errors.h"
@@ -103,19 +104,23 @@ struct line_reader {
   }
 };
 
-// Splits a line into tokens, dropping a trailing comment; rejects NUL bytes.
-static void tokenize(string_view line, const text_pos& pos, std::vector<string_view>& tokens) {
+// Splits a line into tokens, dropping a trailing comment (from a token that starts with '#'); rejects NUL bytes.
+// Returns whether a comment was dropped. With in_name (the arguments of newmtl, usemtl and texture statements) only
+// a lone '#' starts the comment: "Material #1" (3ds Max's default names, kept by exporters) is one name.
+static bool tokenize(string_view line, const text_pos& pos, std::vector<string_view>& tokens, bool in_name = false) {
   tokens.clear();
   if (line.find('\0') != string_view::npos) fail(pos, "NUL byte in text (binary file?)");
   size_t i = 0, n = line.size();
   auto is_sep = [](char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; };
   while (i < n) {
     while (i < n && is_sep(line[i])) i++;
-    if (i == n || line[i] == '#') return;
+    if (i == n) return false;
+    if (line[i] == '#' && (!in_name || tokens.empty() || i + 1 == n || is_sep(line[i + 1]))) return true;
     size_t b = i;
     while (i < n && !is_sep(line[i])) i++;
     tokens.push_back(line.substr(b, i - b));
   }
+  return false;
 }
 
 // The text of tokens [first, end) as written, blanks between them included (names and file names that contain
@@ -128,7 +133,8 @@ static std::string join_from(const std::vector<string_view>& t, size_t first) {
 }
 
 // True when t follows tinyobjloader's number grammar in full: [sign] (digits [. digits] | . digits)
-// [(e|E) [sign] digits], with a decimal exponent of at most 300 in magnitude.
+// [(e|E) [sign] digits]; exponent_too_big when the decimal exponent is above 300 (a negative one of any size is
+// fine: the value rounds to a denormal or 0 in our strtof and in tinyobjloader's ldexp alike).
 static bool number_grammar(string_view t, bool& exponent_too_big) {
   size_t i = 0, n = t.size();
   exponent_too_big = false;
@@ -142,6 +148,7 @@ static bool number_grammar(string_view t, bool& exponent_too_big) {
   if (digits == 0) return false;
   if (i < n && (t[i] == 'e' || t[i] == 'E')) {
     i++;
+    bool negative = i < n && t[i] == '-';
     if (i < n && (t[i] == '+' || t[i] == '-')) i++;
     size_t exp_digits = 0;
     long exponent = 0;
@@ -150,7 +157,7 @@ static bool number_grammar(string_view t, bool& exponent_too_big) {
       i++, exp_digits++;
     }
     if (exp_digits == 0) return false;
-    exponent_too_big = exponent > 300;
+    exponent_too_big = !negative && exponent > 300;
   }
   return i == n;
 }
@@ -337,23 +344,29 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
   size_t first = out.size();
   std::vector<char> has_kd;  // per material of this file: a Kd statement was seen
   size_t transparent_line = 0;  // the first d or Tr statement asking for partial transparency (reported once)
+  std::vector<string_view> named;  // a name statement's tokens, '#' inside names kept (see tokenize)
+  const std::string dir = fs::path(path).parent_path().string();
   while (lines.next(line)) {
     text_pos pos{path, lines.line};
-    tokenize(line, pos, t);
+    bool commented = tokenize(line, pos, t);
     if (t.empty()) continue;
     string_view k = t[0];
+    bool texture =
+        k.compare(0, 4, "map_") == 0 || k == "bump" || k == "disp" || k == "decal" || k == "refl" || k == "norm";
+    if (k == "newmtl" || texture) {
+      if (commented) tokenize(line, pos, named, true);
+      else named = t;
+    }
     if (k == "newmtl") {
-      if (t.size() < 2) fail(pos, "newmtl needs a material name");
+      if (named.size() < 2) fail(pos, "newmtl needs a material name");
       out.emplace_back();
       cur = &out.back();
-      cur->material.name = join_from(t, 1);
+      cur->material.name = join_from(named, 1);
       has_kd.push_back(0);
       cur->mtl_path = path;
       cur->line = int(std::min<size_t>(lines.line, INT_MAX));
       continue;
     }
-    bool texture =
-        k.compare(0, 4, "map_") == 0 || k == "bump" || k == "disp" || k == "decal" || k == "refl" || k == "norm";
     bool known = texture || k == "Kd" || k == "Ks" || k == "Ke" || k == "Ka" || k == "Tf" || k == "Kt" || k == "Ns" ||
                  k == "Ni" || k == "d" || k == "Tr" || k == "illum";
     if (!known) {
@@ -363,7 +376,11 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     if (!cur) fail(pos, quote(k) + " before any newmtl");
     material_data& m = cur->material;
     if (texture) {
-      std::string file = check_texture_statement(t, pos);
+      std::string file = check_texture_statement(named, pos);
+      // "map_Kd wood.png #2" : a file name with '#' in it when there is such a file, else a comment after the name.
+      std::error_code ec;
+      if (named.size() != t.size() && t.size() >= 2 && !fs::is_regular_file(resolve_file_name(dir, file), ec))
+        file = check_texture_statement(t, pos);
       if (k == "map_Kd") cur->kd_map = file, cur->kd_map_line = int(std::min<size_t>(lines.line, INT_MAX));
       if (k == "map_d") cur->alpha_map = file, cur->alpha_map_line = int(std::min<size_t>(lines.line, INT_MAX));
     } else if (k == "Kd" || k == "Ks" || k == "Ke" || k == "Ka" || k == "Tf" || k == "Kt") {
@@ -407,6 +424,8 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
 struct obj_pass_state {
   std::map<std::string, int> used_index;   // usemtl name -> k
   std::vector<std::string> used_names;     // k -> name
+  std::vector<std::string> used_short_names;  // k -> the name before a '#' word in it ("" when none): "usemtl wood
+                                              // #floor" means wood when no material is named "wood #floor"
   std::vector<size_t> used_lines;          // k -> line of its first usemtl
   std::set<std::string> mtl_files;         // resolved MTL paths already read
   std::vector<mtl_material_data> defined;  // all materials of all MTL files, in load order
@@ -448,9 +467,10 @@ obj_clean_data validate_obj(const std::string& path) {
   line_reader lines(text);
   std::vector<string_view> t;
   string_view line;
+  std::vector<string_view> named;  // usemtl's tokens, '#' inside names kept (see tokenize)
   while (lines.next(line)) {
     text_pos pos{path, lines.line};
-    tokenize(line, pos, t);
+    bool commented = tokenize(line, pos, t);
     if (t.empty()) continue;
     string_view k = t[0];
     size_t args = t.size() - 1;
@@ -487,11 +507,14 @@ obj_clean_data validate_obj(const std::string& path) {
       d.face_sizes.push_back(int(args));
       d.face_materials.push_back(current);
     } else if (k == "usemtl") {
-      if (args < 1) fail(pos, "usemtl needs a material name");
-      std::string name = join_from(t, 1);
+      if (commented) tokenize(line, pos, named, true);
+      else named = t;
+      if (named.size() < 2) fail(pos, "usemtl needs a material name");
+      std::string name = join_from(named, 1);
       auto it = st.used_index.emplace(name, int(st.used_names.size())).first;
       if (it->second == int(st.used_names.size())) {
         st.used_names.push_back(name);
+        st.used_short_names.push_back(named.size() != t.size() ? join_from(t, 1) : std::string());
         st.used_lines.push_back(lines.line);
       }
       current = it->second;
@@ -515,6 +538,8 @@ obj_clean_data validate_obj(const std::string& path) {
                 << quote(st.defined[i].material.name) << " is defined again; its first definition is used\n";
   for (size_t k = 0; k < st.used_names.size(); k++) {
     auto it = defined_index.find(st.used_names[k]);
+    if (it == defined_index.end() && !st.used_short_names[k].empty())
+      it = defined_index.find(st.used_short_names[k]);
     if (it != defined_index.end()) {
       d.materials.push_back(st.defined[size_t(it->second)]);
     } else {

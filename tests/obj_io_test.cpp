@@ -318,6 +318,33 @@ TEST_CASE("library and texture names may be quoted or use Windows separators", "
   CHECK(m.textures[0].path == dir.path + "/my mats/tex/two  spaces.png");
 }
 
+TEST_CASE("material and texture names may hold '#' words; a lone '#' starts a comment", "[obj]") {
+  // 3ds Max names materials "Material #25" and exporters keep the names: every such name was cut at its '#' and all
+  // became one material (the first), with a warning that it was defined again.
+  temp_dir dir;
+  write_png(dir, "Wood #2.png");
+  write_png(dir, "plain.png");
+  dir.write("m.mtl",
+            "newmtl Material #1\nKd 1 0 0\nnewmtl Material #2\nKd 0 1 0\n"
+            "newmtl wood # the floor\nKd 0 0 1\nmap_Kd Wood #2.png\n"
+            "newmtl plain\nKd 0.5 0.5 0.5\nmap_Kd plain.png #no such file: a comment\n");
+  auto obj = dir.write("m.obj", "mtllib m.mtl\n" + std::string(square_vertices) +
+                                    "usemtl Material #1\nf 1 2 3\nusemtl Material #2\nf 1 3 4\n"
+                                    "usemtl wood #planks\nf 1 2 4\nusemtl plain # comment\nf 2 3 4\n");
+  mesh_data m = load_obj(obj);
+  REQUIRE(m.materials.size() == 4);
+  CHECK(m.materials[0].name == "Material #1");
+  CHECK(m.materials[0].kd.x == 1.0f);
+  CHECK(m.materials[1].name == "Material #2");
+  CHECK(m.materials[1].kd.y == 1.0f);
+  CHECK(m.materials[2].name == "wood");  // "wood #planks" is not defined: the name before its '#' word
+  CHECK(m.materials[2].kd.z == 1.0f);
+  CHECK(m.materials[3].name == "plain");
+  REQUIRE(m.textures.size() == 2);
+  CHECK(m.textures[size_t(m.materials[2].kd_texture)].path == dir.path + "/Wood #2.png");
+  CHECK(m.textures[size_t(m.materials[3].kd_texture)].path == dir.path + "/plain.png");
+}
+
 TEST_CASE("degenerate triangles are dropped and counted", "[obj]") {
   temp_dir dir;
   auto obj = dir.write("deg.obj", std::string(square_vertices) +
@@ -531,7 +558,12 @@ TEST_CASE("hostile input ends in an input error or a mesh", "[obj]") {
   std::string garbage;
   for (int i = 0; i < 100000; i++) garbage += char((i * 7919 + i / 13) % 256);
   CHECK_FALSE(load_error(dir.write("garbage.obj", garbage)).empty());
-  CHECK_THAT(load_error(dir.write("exp.obj", "v 1e-99999999999999 0 0\n")), Catch::Contains("out of range"));
+  CHECK_THAT(load_error(dir.write("exp.obj", "v 1e99999999999999 0 0\n")), Catch::Contains("out of range"));
+  // A negative exponent of any size is a number that rounds to 0 (C programs print denormals as 1e-310).
+  mesh_data tiny = load_obj(dir.write("tiny.obj", "v 0 0 0\nv 1 1e-310 0\nv 0 1 -1e-99999999999999\nf 1 2 3\n"));
+  REQUIRE(triangle_count(tiny) == 1);
+  CHECK(corner(tiny, 0, 1).y == 0.0f);
+  CHECK(corner(tiny, 0, 2).z == 0.0f);
   // Finite but enormous coordinates: triangles whose area overflows float are dropped as non-finite.
   mesh_data m =
       load_obj(dir.write("huge.obj", "v 0 0 0\nv 3e38 0 0\nv 0 3e38 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 4 5\n"));
