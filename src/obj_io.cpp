@@ -185,9 +185,23 @@ static bool unit_normal(vec3f vn, vec3f& out) {
 static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, const std::string& mtl_path, int line,
                          const char* statement, const std::string& name) {
   if (name.empty()) return invalid_id;
-  std::string path = resolve_file_name(fs::path(mtl_path).parent_path().string(), name);
+  const std::string dir = fs::path(mtl_path).parent_path().string();
+  std::string path = resolve_file_name(dir, name);
   auto it = loaded.find(path);
   if (it != loaded.end()) return it->second;
+  std::error_code ec;
+  if (!fs::exists(path, ec)) {
+    // A path from the machine that wrote the MTL (C:\Users\...\wood.png), or a name in another case: the file
+    // beside the MTL, said once per name (later references find it in `loaded` under the name as resolved).
+    std::string beside = find_beside(dir, name);
+    if (!beside.empty()) {
+      std::cerr << "warning: " << mtl_path << ":" << line << ": " << statement << ": " << name
+                << " does not exist; using " << beside << "\n";
+      int index = texture_index(mesh, loaded, mtl_path, line, statement, beside);
+      loaded.emplace(path, index);
+      return index;
+    }
+  }
   try {
     mesh.textures.push_back(load_texture(path));
   } catch (const input_error& e) {

@@ -273,6 +273,31 @@ std::string resolve_file_name(const std::string& dir, const std::string& written
   return path;
 }
 
+std::string find_beside(const std::string& dir, const std::string& written) {
+  std::string name = written;
+  if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = name.substr(1, name.size() - 2);
+  size_t slash = name.find_last_of("/\\");
+  std::string base = slash == std::string::npos ? name : name.substr(slash + 1);
+  if (base.empty() || base == "." || base == "..") return {};
+  std::error_code ec;
+  fs::path folder = dir.empty() ? fs::path(".") : fs::path(dir);
+  fs::path exact = folder / base;
+  if (fs::is_regular_file(exact, ec)) return exact.lexically_normal().string();
+  auto lower = [](std::string x) {
+    for (char& c : x) c = char(std::tolower((unsigned char)c));
+    return x;
+  };
+  const std::string want = lower(base);
+  std::string found;
+  int matches = 0;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    std::string entry = it->path().filename().string();
+    if (entry.size() == want.size() && lower(entry) == want && fs::is_regular_file(it->path(), ec))
+      found = it->path().lexically_normal().string(), matches++;
+  }
+  return matches == 1 ? found : std::string();  // (two that differ only in case: neither is more right)
+}
+
 // Number of numeric arguments (min, max) of a texture option, or min = -1 when it takes one word.
 struct texture_option {
   const char* name;
@@ -344,6 +369,8 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
   size_t first = out.size();
   std::vector<char> has_kd;  // per material of this file: a Kd statement was seen
   size_t transparent_line = 0;  // the first d or Tr statement asking for partial transparency (reported once)
+  std::map<std::string, size_t> ignored_maps;  // texture statements other than map_Kd and map_d: first line of each
+  std::vector<std::string> ignored_order;     // their keywords in order of first appearance
   std::vector<string_view> named;  // a name statement's tokens, '#' inside names kept (see tokenize)
   const std::string dir = fs::path(path).parent_path().string();
   while (lines.next(line)) {
@@ -376,6 +403,8 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     if (!cur) fail(pos, quote(k) + " before any newmtl");
     material_data& m = cur->material;
     if (texture) {
+      if (k != "map_Kd" && k != "map_d" && ignored_maps.emplace(std::string(k), lines.line).second)
+        ignored_order.emplace_back(k);
       std::string file = check_texture_statement(named, pos);
       // "map_Kd wood.png #2" : a file name with '#' in it when there is such a file, else a comment after the name.
       std::error_code ec;
@@ -383,12 +412,18 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
         file = check_texture_statement(t, pos);
       if (k == "map_Kd") cur->kd_map = file, cur->kd_map_line = int(std::min<size_t>(lines.line, INT_MAX));
       if (k == "map_d") cur->alpha_map = file, cur->alpha_map_line = int(std::min<size_t>(lines.line, INT_MAX));
-    } else if (k == "Kd" || k == "Ks" || k == "Ke" || k == "Ka" || k == "Tf" || k == "Kt") {
+    } else if (k == "Ka" || k == "Tf" || k == "Kt") {
+      // Not rendered: any form is accepted (Ka spectral file.rfl, Tf xyz x y z, ...).
+    } else if (k == "Kd" || k == "Ks" || k == "Ke") {
+      if (t.size() >= 2 && (t[1] == "spectral" || t[1] == "xyz"))
+        fail(pos, quote(k) + " " + std::string(t[1]) + " (" + (t[1] == "xyz" ? "CIE XYZ" : "a spectral curve") +
+                      ") is not supported: write " + std::string(k) + " r g b (linear RGB)");
       vec3f c = colour_at(t, pos);
       if (k == "Kd") m.kd = c, has_kd.back() = 1;
       if (k == "Ks") m.ks = c;
       if (k == "Ke") m.ke = c;
     } else {
+      if (k == "d" && t.size() == 3 && t[1] == "-halo") t.erase(t.begin() + 1);  // "d -halo 0.8": not rendered either
       float v = scalar_at(t, pos);
       if (k == "Ns" && v < 0) fail(pos, "Ns must not be negative");
       if ((k == "d" || k == "Tr") && !(v >= 0 && v <= 1)) fail(pos, quote(k) + " must lie in [0, 1]");
@@ -410,6 +445,12 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     if (bright.size() > named) list += " and " + std::to_string(bright.size() - named) + " more";
     std::cerr << "warning: " << path << ": material" << (bright.size() > 1 ? "s " : " ") << list
               << (bright.size() > 1 ? " have" : " has") << " Kd + Ks above 1, scaled down to conserve energy\n";
+  }
+  if (!ignored_order.empty()) {
+    std::cerr << "warning: " << path << ": textures other than map_Kd and map_d are not rendered:";
+    for (size_t i = 0; i < ignored_order.size(); i++)
+      std::cerr << (i ? ", " : " ") << ignored_order[i] << " (line " << ignored_maps[ignored_order[i]] << ")";
+    std::cerr << "\n";
   }
   if (transparent_line > 0)
     std::cerr << "warning: " << path << ":" << transparent_line
@@ -445,6 +486,14 @@ static void handle_mtllib(const std::vector<string_view>& t, const std::string& 
   }
   for (const auto& name : names) {
     std::string file = resolve_file_name(dir, name);
+    if (!fs::exists(file, ec)) {
+      std::string beside = find_beside(dir, name);  // (a path from the machine that wrote the OBJ)
+      if (!beside.empty()) {
+        std::cerr << "warning: " << pos.file << ":" << pos.line << ": mtllib: " << name << " does not exist; using "
+                  << beside << "\n";
+        file = beside;
+      }
+    }
     if (!st.mtl_files.insert(file).second) continue;
     try {
       validate_mtl(file, st.defined);

@@ -45,6 +45,10 @@ obj_clean_data validate_obj(const std::string& path);
 // relative to dir; one pair of surrounding double quotes is dropped; Windows separators ('\\') are tried as '/'
 // when the name as written is not a file.
 std::string resolve_file_name(const std::string& dir, const std::string& written);
+// Where a file named `written` that resolve_file_name did not find may be after all, as other readers look for it:
+// its last path component (after '/' or '\\': a path from the machine that wrote the file) in folder dir, written
+// exactly, else the one entry of dir equal to it but for ASCII case; "" when there is none.
+std::string find_beside(const std::string& dir, const std::string& written);
 
 // Reads a whole regular file; throws input_error (naming what, e.g. "material library") when it cannot.
 std::string read_text_file(const std::string& path, const char* what);

@@ -345,6 +345,45 @@ TEST_CASE("material and texture names may hold '#' words; a lone '#' starts a co
   CHECK(m.textures[size_t(m.materials[3].kd_texture)].path == dir.path + "/plain.png");
 }
 
+TEST_CASE("files named with another machine's path or in another case are found beside the file naming them",
+          "[obj]") {
+  temp_dir dir;
+  write_png(dir, "wood.png");
+  write_png(dir, "Leaf.png");
+  dir.write("lib2.mtl", "newmtl a\nmap_Kd C:\\Users\\artist\\Documents\\maps\\wood.png\n"
+                        "newmtl b\nmap_d leaf.PNG\nmap_Kd /home/someone/wood.png\n");
+  auto obj = dir.write("p.obj", "mtllib D:\\work\\lib2.mtl\n" + std::string(square_vertices) +
+                                    "vt 0.25 0.5\nusemtl a\nf 1/1 2/1 3/1\nusemtl b\nf 1/1 3/1 4/1\n");
+  mesh_data m = load_obj(obj);
+  REQUIRE(m.materials.size() == 2);
+  REQUIRE(m.textures.size() == 2);  // wood.png once, for both names that lead to it
+  CHECK(m.textures[size_t(m.materials[0].kd_texture)].path == dir.path + "/wood.png");
+  CHECK(m.materials[1].kd_texture == m.materials[0].kd_texture);
+  CHECK(m.textures[size_t(m.materials[1].alpha_texture)].path == dir.path + "/Leaf.png");
+  // Not found under any of those names: the error names the file as written.
+  dir.write("lib3.mtl", "newmtl a\nmap_Kd C:\\maps\\stone.png\n");
+  auto bad = dir.write("q.obj", "mtllib lib3.mtl\n" + std::string(square_vertices) + "usemtl a\nf 1 2 3\n");
+  CHECK_THAT(load_error(bad), Catch::Contains("stone.png"));
+}
+
+TEST_CASE("MTL statements that are not rendered are accepted in any of their forms", "[obj]") {
+  temp_dir dir;
+  write_png(dir, "glow.png");
+  dir.write("n.mtl",
+            "newmtl a\nKd 0.5 0.5 0.5\nKa spectral ident.rfl 1.0\nTf xyz 1 1 1\nKt 1\nd -halo 0.8\n"
+            "map_Ke glow.png\nbump -bm 0.5 glow.png\nmap_Ks glow.png\n");
+  auto obj = dir.write("n.obj", "mtllib n.mtl\n" + std::string(square_vertices) + "usemtl a\nf 1 2 3\n");
+  mesh_data m = load_obj(obj);
+  REQUIRE(m.materials.size() == 1);
+  CHECK(m.materials[0].kd.x == 0.5f);
+  CHECK(m.materials[0].kd_texture == invalid_id);
+  CHECK(m.textures.empty());  // (only map_Kd and map_d are read)
+  // Kd, Ks and Ke are rendered: a spectral or XYZ form is refused by name.
+  dir.write("s.mtl", "newmtl a\nKd spectral wood.rfl 1.0\n");
+  auto bad = dir.write("s.obj", "mtllib s.mtl\n" + std::string(square_vertices) + "usemtl a\nf 1 2 3\n");
+  CHECK_THAT(load_error(bad), Catch::Contains("'Kd' spectral (a spectral curve) is not supported: write Kd r g b"));
+}
+
 TEST_CASE("degenerate triangles are dropped and counted", "[obj]") {
   temp_dir dir;
   auto obj = dir.write("deg.obj", std::string(square_vertices) +
