@@ -311,6 +311,8 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   for (const material_data& mat : m.materials) {
     h.vec(mat.kd), h.vec(mat.ks), h.vec(mat.ke), h.value(mat.ns);
     h.value(mat.kd_texture), h.value(mat.alpha_texture);
+    for (const texture_transform* t : {&mat.kd_map, &mat.alpha_map})
+      h.value(t->scale.x), h.value(t->scale.y), h.value(t->offset.x), h.value(t->offset.y), h.value(t->clamp);
   }
   for (const texture_data& t : m.textures) {
     h.value(t.width), h.value(t.height);

@@ -11,7 +11,8 @@ bsdf_data make_bsdf(const scene_data& scene, const surface_point& sp) {
   const material_data& m = scene.mesh.materials[sp.material];
   bsdf_data b;
   b.kd = m.kd;
-  if (m.kd_texture != invalid_id) b.kd = b.kd * eval_texture_rgb(scene.mesh.textures[m.kd_texture], sp.uv);
+  if (m.kd_texture != invalid_id)
+    b.kd = b.kd * eval_texture_rgb(scene.mesh.textures[m.kd_texture], transform_uv(m.kd_map, sp.uv), m.kd_map.clamp);
   b.ks = m.ks;
   b.ns = std::min(std::max(m.ns, 0.0f), max_phong_exponent);
   float total = max_component(b.kd + b.ks);

@@ -29,6 +29,7 @@ struct material_data {
   vec3f ke = {0, 0, 0};           // Ke emitted radiance (non-zero: the triangle is an area light)
   int kd_texture = invalid_id;    // map_Kd: index into mesh_data::textures
   int alpha_texture = invalid_id; // map_d: index into mesh_data::textures
+  texture_transform kd_map, alpha_map;  // map_Kd's and map_d's -s, -o and -clamp
 };
 
 // A triangle mesh as flat columns; corner c of triangle t is entry 3*t+c of the tri_* corner arrays.

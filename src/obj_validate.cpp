@@ -308,8 +308,13 @@ static const texture_option texture_options[] = {
     {"-type", -1, 1},   {"-colorspace", -1, 1}, {"-boost", 1, 1},  {"-bm", 1, 1},  {"-texres", 1, 1},
     {"-mm", 1, 2},      {"-o", 1, 3},           {"-s", 1, 3},      {"-t", 1, 3}};
 
-// Checks a texture statement (options, then a file name) and returns the file name.
-static std::string check_texture_statement(const std::vector<string_view>& t, const text_pos& pos) {
+// Checks a texture statement (options, then a file name) and returns the file name; -s, -o and -clamp go to xf (when
+// given): u and v of -s and -o (a v left out is u's default, 1 for -s and 0 for -o; w has no use on a 2D image).
+static std::string check_texture_statement(const std::vector<string_view>& t, const text_pos& pos,
+                                           texture_transform* xf = nullptr) {
+  texture_transform local;
+  if (!xf) xf = &local;
+  *xf = {};
   size_t i = 1;
   while (i < t.size() && t[i].size() > 1 && t[i][0] == '-') {
     const texture_option* opt = nullptr;
@@ -321,19 +326,26 @@ static std::string check_texture_statement(const std::vector<string_view>& t, co
       if (i >= t.size()) fail(pos, "texture option " + quote(name) + " needs a value");
       bool on_off = name == "-blendu" || name == "-blendv" || name == "-clamp" || name == "-cc";
       if (on_off && t[i] != "on" && t[i] != "off") fail(pos, "texture option " + quote(name) + " takes on or off");
+      if (name == "-clamp") xf->clamp = t[i] == "on";
       i++;
       continue;
     }
+    float args[3] = {0, 0, 0};
+    int got = 0;
     for (int k = 0; k < opt->max_args; k++) {
       float v = 0;
       if (k < opt->min_args) {
         if (i >= t.size()) fail(pos, "texture option " + quote(name) + " needs a number");
-        number_at(t[i], pos);
+        v = number_at(t[i], pos);
       } else if (i >= t.size() || !try_number(t[i], v, nullptr)) {
         break;
       }
+      args[k] = v;
+      got++;
       i++;
     }
+    if (name == "-s") xf->scale = {args[0], got > 1 ? args[1] : 1.0f};
+    if (name == "-o") xf->offset = {args[0], got > 1 ? args[1] : 0.0f};
   }
   if (i >= t.size()) fail(pos, quote(t[0]) + " needs a file name");
   return join_from(t, i);
@@ -405,13 +417,20 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     if (texture) {
       if (k != "map_Kd" && k != "map_d" && ignored_maps.emplace(std::string(k), lines.line).second)
         ignored_order.emplace_back(k);
-      std::string file = check_texture_statement(named, pos);
+      texture_transform xf;
+      std::string file = check_texture_statement(named, pos, &xf);
       // "map_Kd wood.png #2" : a file name with '#' in it when there is such a file, else a comment after the name.
       std::error_code ec;
       if (named.size() != t.size() && t.size() >= 2 && !fs::is_regular_file(resolve_file_name(dir, file), ec))
-        file = check_texture_statement(t, pos);
-      if (k == "map_Kd") cur->kd_map = file, cur->kd_map_line = int(std::min<size_t>(lines.line, INT_MAX));
-      if (k == "map_d") cur->alpha_map = file, cur->alpha_map_line = int(std::min<size_t>(lines.line, INT_MAX));
+        file = check_texture_statement(t, pos, &xf);
+      if (k == "map_Kd") {
+        cur->kd_map = file, cur->kd_map_line = int(std::min<size_t>(lines.line, INT_MAX));
+        cur->material.kd_map = xf;
+      }
+      if (k == "map_d") {
+        cur->alpha_map = file, cur->alpha_map_line = int(std::min<size_t>(lines.line, INT_MAX));
+        cur->material.alpha_map = xf;
+      }
     } else if (k == "Ka" || k == "Tf" || k == "Kt") {
       // Not rendered: any form is accepted (Ka spectral file.rfl, Tf xyz x y z, ...).
     } else if (k == "Kd" || k == "Ks" || k == "Ke") {

@@ -140,8 +140,10 @@ vec2f surface_uv(const scene_data& scene, int tri, float b1, float b2) {
 }
 
 bool alpha_hole(const scene_data& scene, int tri, float b1, float b2) {
-  int tex = scene.mesh.materials[size_t(scene.mesh.tri_materials[size_t(tri)])].alpha_texture;
-  return tex != invalid_id && eval_texture_alpha(scene.mesh.textures[size_t(tex)], surface_uv(scene, tri, b1, b2)) < 0.5f;
+  const material_data& m = scene.mesh.materials[size_t(scene.mesh.tri_materials[size_t(tri)])];
+  if (m.alpha_texture == invalid_id) return false;
+  vec2f uv = transform_uv(m.alpha_map, surface_uv(scene, tri, b1, b2));
+  return eval_texture_alpha(scene.mesh.textures[size_t(m.alpha_texture)], uv, m.alpha_map.clamp) < 0.5f;
 }
 
 }  // namespace bl

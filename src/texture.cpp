@@ -272,32 +272,41 @@ static float wrap01(float x) {
   return (f >= 0.0f && f < 1.0f) ? f : 0.0f;
 }
 
-// Bilinear footprint along one axis of n texels: lower texel i0, upper i1 (wrapped) and the weight of i1.
+// x limited to [0, 1]; NaN maps to 0.
+static float clamp01(float x) { return x >= 0.0f ? (x <= 1.0f ? x : 1.0f) : 0.0f; }
+
+// Bilinear footprint along one axis of n texels: lower texel i0, upper i1 and the weight of i1; beyond the first and
+// last texel centres i1 wraps to the other edge, or with clamp both are the edge texel.
 // Texel k covers [k, k+1) / n, its centre at (k + 0.5) / n.
-static void axis_footprint(float f, int n, int& i0, int& i1, float& w1) {
-  float s = f * float(n) - 0.5f;  // in [-0.5, n - 0.5)
+static void axis_footprint(float f, int n, bool clamp, int& i0, int& i1, float& w1) {
+  float s = f * float(n) - 0.5f;  // in [-0.5, n - 0.5] (n - 0.5 only when clamped at 1)
   float fl = floorf(s);
   w1 = s - fl;
   int k = int(fl);  // in [-1, n - 1]
+  if (clamp) {
+    i0 = k < 0 ? 0 : (k > n - 1 ? n - 1 : k);
+    i1 = k + 1 < 0 ? 0 : (k + 1 > n - 1 ? n - 1 : k + 1);
+    return;
+  }
   if (k < 0) k = n - 1;
   if (k > n - 1) k = n - 1;
   i0 = k;
   i1 = k + 1 < n ? k + 1 : 0;
 }
 
-// Nearest texel index along one axis of n texels for f in [0, 1).
+// Nearest texel index along one axis of n texels for f in [0, 1] (1: the last).
 static int axis_nearest(float f, int n) {
   int k = int(f * float(n));
   return k < 0 ? 0 : (k > n - 1 ? n - 1 : k);
 }
 
-vec3f eval_texture_rgb(const texture_data& tex, vec2f uv) {
+vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp) {
   if (!texture_complete(tex)) return {0, 0, 0};
   int x0, x1, b0, b1;
   float wx, wb;
-  axis_footprint(wrap01(uv.x), tex.width, x0, x1, wx);
+  axis_footprint(clamp ? clamp01(uv.x) : wrap01(uv.x), tex.width, clamp, x0, x1, wx);
   // v counts rows from the bottom: bottom-based row b is image row height - 1 - b.
-  axis_footprint(wrap01(uv.y), tex.height, b0, b1, wb);
+  axis_footprint(clamp ? clamp01(uv.y) : wrap01(uv.y), tex.height, clamp, b0, b1, wb);
   int y0 = tex.height - 1 - b0, y1 = tex.height - 1 - b1;
   auto at = [&](int x, int y) { return texel_rgb(tex, size_t(y) * size_t(tex.width) + size_t(x)); };
   vec3f lo = at(x0, y0) * (1.0f - wx) + at(x1, y0) * wx;
@@ -305,10 +314,10 @@ vec3f eval_texture_rgb(const texture_data& tex, vec2f uv) {
   return lo * (1.0f - wb) + hi * wb;
 }
 
-float eval_texture_alpha(const texture_data& tex, vec2f uv) {
+float eval_texture_alpha(const texture_data& tex, vec2f uv, bool clamp) {
   if (!texture_complete(tex)) return 1.0f;
-  int x = axis_nearest(wrap01(uv.x), tex.width);
-  int y = tex.height - 1 - axis_nearest(wrap01(uv.y), tex.height);
+  int x = axis_nearest(clamp ? clamp01(uv.x) : wrap01(uv.x), tex.width);
+  int y = tex.height - 1 - axis_nearest(clamp ? clamp01(uv.y) : wrap01(uv.y), tex.height);
   return texel_alpha(tex, size_t(y) * size_t(tex.width) + size_t(x));
 }
 

@@ -1,6 +1,7 @@
 // texture: image textures of OBJ materials (map_Kd diffuse colour, map_d alpha cut-out mask).
 // Invariants: texels are stored as the file's 8- or 16-bit values and decoded to linear through fixed float tables,
-// top row first; lookups wrap (repeat) in u and v, with v = 0 at the bottom of the image as in OBJ. All maths is
+// top row first; lookups wrap (repeat) in u and v, or clamp to the edge texels (MTL -clamp on), with v = 0 at the
+// bottom of the image as in OBJ. All maths is
 // float (powf for the sRGB tables, floorf for wrapping), so textures decode and filter identically on any CPU.
 #pragma once
 
@@ -61,10 +62,21 @@ texture_data load_texture(const std::string& path);
 // A texture of 8-bit texels (width * height * channels values, row-major, top row first; colour sRGB-encoded).
 texture_data texture_from_texels8(std::string path, int width, int height, int channels, std::vector<uint8_t> texels);
 
-// Linear RGB at texture coordinate uv (bilinear, repeat wrap).
-vec3f eval_texture_rgb(const texture_data& tex, vec2f uv);
-// Alpha mask at uv (nearest texel, repeat wrap): cut-outs keep hard edges and cost one fetch.
-float eval_texture_alpha(const texture_data& tex, vec2f uv);
+// Linear RGB at texture coordinate uv (bilinear; repeat wrap, or with clamp the edge texels beyond [0, 1]).
+vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp = false);
+// Alpha mask at uv (nearest texel; repeat wrap or clamp): cut-outs keep hard edges and cost one fetch.
+float eval_texture_alpha(const texture_data& tex, vec2f uv, bool clamp = false);
+
+// How a material's texture statement maps surface coordinates onto its image: MTL -s (scale) and -o (offset), u and
+// v (w has no use on a 2D image): the image is read at uv * scale + offset; -clamp on: not repeated.
+struct texture_transform {
+  vec2f scale = {1, 1};
+  vec2f offset = {0, 0};
+  bool clamp = false;
+};
+inline vec2f transform_uv(const texture_transform& t, vec2f uv) {
+  return {uv.x * t.scale.x + t.offset.x, uv.y * t.scale.y + t.offset.y};
+}
 
 // sRGB-encoded 8-bit value to linear float (exact table of the sRGB EOTF in float maths).
 float srgb8_to_linear(unsigned char v);

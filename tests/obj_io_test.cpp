@@ -2,6 +2,7 @@
 // degenerate triangles, compaction, and that every malformed or hostile input is an input_error naming the
 // file and line. Each test writes its OBJ/MTL/PNG files into a fresh mkdtemp directory.
 #include "errors.h"
+#include "material.h"
 #include "obj_io.h"
 #include "scene.h"
 
@@ -289,6 +290,50 @@ TEST_CASE("map_Kd and map_d are resolved beside the MTL and decoded once", "[obj
   CHECK(texel_alpha(t, 0) == 1.0f);
   CHECK(texel_alpha(t, 1) == 0.0f);
   CHECK(eval_texture_alpha(t, {0.9f, 0.5f}) == 0.0f);
+  // Texture options: -s and -o (u v, w ignored; a v left out takes u's default) and -clamp reach the material.
+  CHECK(m.materials[0].kd_map.clamp == false);
+  CHECK(m.materials[0].kd_map.scale.x == 1.0f);
+  dir.write("mats/opt.mtl", "newmtl a\nmap_Kd -s 2 3 1 -o 0.25 0.5 7 -clamp on tex/a.png\n"
+                            "map_d -s 4 -o 0.125 tex/a.png\n");
+  auto obj2 = dir.write("o.obj", "mtllib mats/opt.mtl\n" + std::string(square_vertices) + "usemtl a\nf 1 2 3\n");
+  mesh_data o = load_obj(obj2);
+  REQUIRE(o.materials.size() == 1);
+  const material_data& a = o.materials[0];
+  CHECK(a.kd_map.scale.x == 2.0f);
+  CHECK(a.kd_map.scale.y == 3.0f);
+  CHECK(a.kd_map.offset.x == 0.25f);
+  CHECK(a.kd_map.offset.y == 0.5f);
+  CHECK(a.kd_map.clamp);
+  CHECK(a.alpha_map.scale.x == 4.0f);
+  CHECK(a.alpha_map.scale.y == 1.0f);
+  CHECK(a.alpha_map.offset.x == 0.125f);
+  CHECK(a.alpha_map.offset.y == 0.0f);
+  CHECK_FALSE(a.alpha_map.clamp);
+}
+
+TEST_CASE("shading and cut-outs read textures through the statement's -o and -clamp", "[obj]") {
+  // The 2x1 texture: texel 0 grey and opaque, texel 1 white and a hole. A point at uv (0.75, 0.25) reads texel 1; with
+  // -o 0.5 (read at u + 0.5, wrapped) texel 0; with -s 2 -clamp on (u 1.5, clamped) texel 1 again; -s 3, texel 0.
+  temp_dir dir;
+  write_png(dir, "a.png");
+  camera_params cam;
+  cam.eye = {0.5f, 0.5f, 2};
+  cam.target = {0.5f, 0.5f, 0};
+  for (const char* options : {"", "-o 0.5 ", "-o 1.5 ", "-s 2 -clamp on ", "-s 3 "}) {
+    INFO("options: " << options);
+    dir.write("x.mtl", std::string("newmtl a\nmap_Kd ") + options + "a.png\nmap_d " + options + "a.png\n");
+    auto obj = dir.write("x.obj", "mtllib x.mtl\n" + std::string(square_vertices) +
+                                      "vt 0 0\nvt 1 0\nvt 1 1\nusemtl a\nf 1/1 2/2 3/3\n");
+    scene_data scene = build_scene(load_obj(obj), cam, sun_params{}, false, 1.0f);
+    REQUIRE(triangle_count(scene.mesh) == 1);
+    surface_point sp = eval_surface(scene, 0, 0.5f, 0.25f, {0, 0, -1});
+    REQUIRE(sp.uv.x == 0.75f);
+    const bool texel1 = std::string(options).find("-o 0.5") == std::string::npos &&
+                        std::string(options).find("-o 1.5") == std::string::npos &&
+                        std::string(options) != "-s 3 ";  // unclamped, u 2.25 wraps to texel 0
+    CHECK(alpha_hole(scene, 0, 0.5f, 0.25f) == texel1);
+    CHECK(make_bsdf(scene, sp).kd.x == Approx(texel1 ? 1.0f : 0.2158605f).margin(1e-6));
+  }
 }
 
 TEST_CASE("library and texture names may be quoted or use Windows separators", "[obj]") {

@@ -116,6 +116,28 @@ TEST_CASE("bilinear lookup weighs the two nearest texel centres", "[texture]") {
   CHECK(eval_texture_alpha(t, {0.51f, 0.5f}) == 1.0f);
 }
 
+TEST_CASE("clamped lookups keep the edge texels beyond [0, 1] and at the seam", "[texture]") {
+  temp_dir dir;
+  auto path = write_png(dir, "ramp.png", 2, 1, 1, {0, 255});  // linear 0 and 1
+  texture_data t = load_texture(path);
+  CHECK(eval_texture_rgb(t, {0.0f, 0.5f}, true).x == 0.0f);  // no blend with the other edge (wrapped: 0.5)
+  CHECK(eval_texture_rgb(t, {1.0f, 0.5f}, true).x == 1.0f);
+  CHECK(eval_texture_rgb(t, {1.7f, 0.5f}, true).x == 1.0f);  // (wrapped: 0.7 lies between the centres)
+  CHECK(eval_texture_rgb(t, {-3.0f, 0.5f}, true).x == 0.0f);
+  CHECK(eval_texture_rgb(t, {0.5f, 0.5f}, true).x == Approx(0.5f));  // inside, as wrapped
+  CHECK(eval_texture_alpha(t, {1.2f, 0.5f}, true) == 1.0f);            // (wrapped: texel 0)
+  CHECK(eval_texture_alpha(t, {1.2f, 0.5f}) == 0.0f);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  CHECK(eval_texture_rgb(t, {nan, nan}, true).x == 0.0f);
+  // MTL -s and -o: the image is read at uv * scale + offset.
+  texture_transform xf;
+  xf.scale = {2, 3};
+  xf.offset = {0.25f, -0.5f};
+  vec2f uv = transform_uv(xf, {0.5f, 0.5f});
+  CHECK(uv.x == 1.25f);
+  CHECK(uv.y == 1.0f);
+}
+
 TEST_CASE("lookups repeat and survive huge negative and NaN coordinates", "[texture]") {
   temp_dir dir;
   auto path = write_png(dir, "wrap.png", 4, 3, 3,
