@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <queue>
+#include <unordered_set>
 
 #include <tbb/parallel_for.h>
 
@@ -191,19 +192,38 @@ namespace {
 // and a key's pairs are a function of the key), so the key is neither requested nor its cut computed again.
 constexpr int over_budget = -1;
 
+// Most keys the pending table holds: a fine grid (--grid 100000) gives nearly every sample a cell of its own that
+// never reaches min_samples, and the table grew by 35-40 bytes per NEE sample without end. At the limit the counts
+// are forgotten (the marks of keys over the budget kept while they fit); a grid of the default size never gets near
+// it. The limit is reached at the same request of the same pass with any thread count: deterministic.
+size_t pending_limit(const region_state& s) { return std::max<size_t>(size_t(1) << 20, size_t(s.params.max_pairs)); }
+
+// Rebuilds the pending table with the entries that `keep` selects.
+template <class Keep>
+void rebuild_pending(region_state& s, size_t slots, Keep keep) {
+  std::vector<region_slot> old = std::move(s.pending);
+  s.pending.assign(slots, region_slot{empty_region_key, 0});
+  s.pending_count = 0;
+  size_t mask = s.pending.size() - 1;
+  for (const region_slot& e : old)
+    if (e.key != empty_region_key && keep(e)) {
+      size_t h = size_t(mix64(e.key)) & mask;
+      while (s.pending[h].key != empty_region_key) h = (h + 1) & mask;
+      s.pending[h] = e;
+      s.pending_count++;
+    }
+}
+
 // The pending slot of a key, inserted with count 0 if new.
 region_slot& pending_slot(region_state& s, uint64_t key) {
-  if (2 * (s.pending_count + 1) > s.pending.size()) {
-    std::vector<region_slot> old = std::move(s.pending);
-    s.pending.assign(std::max<size_t>(64, 2 * old.size()), region_slot{empty_region_key, 0});
-    size_t mask = s.pending.size() - 1;
-    for (const region_slot& e : old)
-      if (e.key != empty_region_key) {
-        size_t h = size_t(mix64(e.key)) & mask;
-        while (s.pending[h].key != empty_region_key) h = (h + 1) & mask;
-        s.pending[h] = e;
-      }
+  if (s.pending_count + 1 > pending_limit(s)) {
+    size_t marks = 0;
+    for (const region_slot& e : s.pending) marks += e.key != empty_region_key && e.id == over_budget;
+    bool keep_marks = 2 * marks <= pending_limit(s);
+    rebuild_pending(s, s.pending.size(), [&](const region_slot& e) { return keep_marks && e.id == over_budget; });
   }
+  if (2 * (s.pending_count + 1) > s.pending.size())
+    rebuild_pending(s, std::max<size_t>(64, 2 * s.pending.size()), [](const region_slot&) { return true; });
   size_t mask = s.pending.size() - 1;
   size_t h = size_t(mix64(key)) & mask;
   while (s.pending[h].key != empty_region_key && s.pending[h].key != key) h = (h + 1) & mask;
@@ -212,6 +232,16 @@ region_slot& pending_slot(region_state& s, uint64_t key) {
     s.pending_count++;
   }
   return s.pending[h];
+}
+
+// The pending slot of a key, or nullptr.
+const region_slot* find_pending(const region_state& s, uint64_t key) {
+  if (s.pending.empty()) return nullptr;
+  size_t mask = s.pending.size() - 1;
+  for (size_t h = size_t(mix64(key)) & mask;; h = (h + 1) & mask) {
+    if (s.pending[h].key == key) return &s.pending[h];
+    if (s.pending[h].key == empty_region_key) return nullptr;
+  }
 }
 
 }  // namespace
@@ -281,14 +311,21 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
     uint64_t parent_key;  // empty_region_key for coarse regions
   };
   std::vector<pending> todo;
-  std::vector<uint64_t> new_coarse;
+  std::unordered_set<uint64_t> new_coarse;  // (a set: a list searched per key was quadratic in the new keys)
+  auto refused = [&](uint64_t key) {
+    const region_slot* slot = find_pending(s, key);
+    return slot && slot->id == over_budget;
+  };
   for (uint64_t key : fine_keys) {
     if (find_region_key(s, key) != invalid_id) continue;
     bool coarse_only = is_coarse_key(key);
     uint64_t ckey = coarse_only ? key : parent_region_key(s.grid, key, 1);
-    if (find_region_key(s, ckey) == invalid_id && std::find(new_coarse.begin(), new_coarse.end(), ckey) == new_coarse.end()) {
-      new_coarse.push_back(ckey);
-      todo.push_back({ckey, empty_region_key});
+    if (find_region_key(s, ckey) == invalid_id) {
+      if (refused(ckey)) {  // the coarse allowance is spent: neither it nor its fine cells get a region
+        if (!coarse_only) pending_slot(s, key).id = over_budget;
+        continue;
+      }
+      if (new_coarse.insert(ckey).second) todo.push_back({ckey, empty_region_key});
     }
     if (!coarse_only) todo.push_back({key, ckey});
   }
@@ -300,17 +337,29 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
       cuts[i] = compute_light_cut(tree, box, s.has_sun, s.params);
       if (s.members) compute_members(tree, box, cuts[i], s.params.max_members, members[i], group[i]);
     });
+  // Coarse regions are few against the fine ones (a coarse cell holds 512 fine ones: in the data/ scenes their pairs
+  // are 2-6 % of all) and take no part in the budget while their own pairs stay within it; then (a fine grid whose
+  // fine regions the budget turned down, a coarse region for each: 7.6 times the budget at --grid 1024) they are
+  // turned down too, and their fine cells with them: the root serves there. So all pairs stay within twice it.
+  int64_t coarse_pairs = 0;
+  for (size_t r = 0; r < s.key.size(); r++)
+    if (is_coarse_key(s.key[r])) coarse_pairs += s.pair_count[r];
+  const int64_t coarse_allowance = s.params.max_pairs;
   int added = 0;
   for (size_t i = 0; i < todo.size(); i++) {
     bool coarse = todo[i].parent_key == empty_region_key;
     int64_t n = s.shared_cut ? s.cut_size[0] : s.members ? int64_t(members[i].size()) : int64_t(cuts[i].size());
-    // Coarse regions are at most 1/512 of the fine ones; they ignore the budget. Over budget, the coarse region serves
-    // for good (the key is marked in the pending table and not tried again).
-    if (!coarse && s.pairs + n > s.params.max_pairs) {
+    // Over budget, the coarse region serves for good (the key is marked in the pending table and not tried again).
+    if (coarse ? coarse_pairs + n > coarse_allowance : s.pairs + n > s.params.max_pairs) {
       pending_slot(s, todo[i].key).id = over_budget;
       continue;
     }
     int parent = coarse ? invalid_id : find_region_key(s, todo[i].parent_key);
+    if (!coarse && parent == invalid_id) {  // its coarse region was turned down just now
+      pending_slot(s, todo[i].key).id = over_budget;
+      continue;
+    }
+    if (coarse) coarse_pairs += n;
     append_region(s, todo[i].key, s.shared_cut ? nullptr : &cuts[i], s.members ? &members[i] : nullptr,
                   s.members ? &group[i] : nullptr, parent, &tree);
     added++;

@@ -503,7 +503,7 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
 
 TEST_CASE("fine regions over the pair budget are not created, and their keys are not tried again", "[samplers][regions]") {
   // The fine cells that shading points reach, requested at once under a pair budget that holds about half of what
-  // they ask for: the regions that fit are created (coarse ones regardless of the budget), the others are not, and
+  // they ask for: the regions that fit are created (coarse ones within their own allowance), the others are not, and
   // their keys stay out for good: their pairs are a function of the key and the pair count only grows, so a key
   // once over the budget would only have its cut computed again at every pass, to be turned down again.
   auto t = make_test_scene(false);
@@ -546,6 +546,48 @@ TEST_CASE("fine regions over the pair budget are not created, and their keys are
   CHECK(add_regions(s, t->tree, refused) == 0);
   CHECK_FALSE(add_pending(s, ~uint64_t(0) >> 3, uint32_t(rp.min_samples - 1)));
   CHECK(add_pending(s, ~uint64_t(0) >> 3, 1));
+}
+
+TEST_CASE("coarse regions keep within the pair budget of their own, and the pending table within its limit",
+          "[samplers][regions]") {
+  // A fine grid's fine regions turned down by the budget each still brought a coarse region, with no limit (7.6 times
+  // the budget at --grid 1024), and every cell a sample touched stayed in the pending table for good (35-40 bytes per
+  // NEE sample at --grid 100000).
+  auto t = make_test_scene(false);
+  region_params rp;
+  rp.grid = 16;
+  rp.max_members = 8;
+  std::vector<uint64_t> keys;
+  region_state probe = make_region_state(t->scene.bounds, t->tree, false, rp);
+  for (const shade_point& sp : shading_points(*t, 400, 21)) keys.push_back(fine_region_key(probe.grid, sp.p));
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  const int64_t base = probe.pairs;  // the root's
+  add_regions(probe, t->tree, keys);
+  int64_t coarse_wanted = 0, coarse_regions = 0;
+  for (size_t r = 0; r < probe.key.size(); r++)
+    if (is_coarse_key(probe.key[r])) coarse_wanted += probe.pair_count[r], coarse_regions++;
+  REQUIRE(coarse_regions >= 3);
+  // A budget that holds no fine region beside the root, and about half the coarse ones' pairs.
+  rp.max_pairs = base + coarse_wanted / 2;
+  region_state s = make_region_state(t->scene.bounds, t->tree, false, rp);
+  add_regions(s, t->tree, keys);
+  int64_t coarse_pairs = 0;
+  for (size_t r = 0; r < s.key.size(); r++)
+    if (is_coarse_key(s.key[r])) coarse_pairs += s.pair_count[r];
+  CHECK(coarse_pairs > 0);
+  CHECK(coarse_pairs <= rp.max_pairs);
+  std::vector<uint64_t> rooted;  // fine keys whose coarse region was turned down: the root serves them, for good
+  for (uint64_t key : keys)
+    if (find_region(s, key) == s.root) rooted.push_back(key);
+  REQUIRE(!rooted.empty());
+  for (uint64_t key : rooted) CHECK_FALSE(add_pending(s, key, 1u << 20));
+  // Cells that never gather min_samples requests: the table forgets their counts at its limit (2^20 keys here),
+  // keeping the marks of keys over the budget.
+  for (uint64_t i = 0; i < 1'300'000; i++) add_pending(s, (uint64_t(1) << 40) + i * 7919, 1);
+  CHECK(s.pending_count <= size_t(1) << 20);
+  CHECK(s.pending.size() <= size_t(1) << 21);
+  for (uint64_t key : rooted) CHECK_FALSE(add_pending(s, key, 1u << 20));
 }
 
 TEST_CASE("a scene without any light gives empty light selections", "[samplers]") {
