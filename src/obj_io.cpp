@@ -8,8 +8,11 @@
 
 #include "errors.h"
 #include "obj_validate.h"
+#include "rng.h"
 
 #include <tiny_obj_loader.h>
+
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <array>
@@ -202,12 +205,25 @@ static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, co
       return index;
     }
   }
+  // The same file by another name (absolute and relative, a symbolic or hard link) is decoded once: by its identity.
+  struct stat st;
+  std::string identity;
+  if (::stat(path.c_str(), &st) == 0)
+    identity = "\n" + std::to_string(uint64_t(st.st_dev)) + ":" + std::to_string(uint64_t(st.st_ino));  // no path
+  if (!identity.empty()) {
+    auto same = loaded.find(identity);
+    if (same != loaded.end()) {
+      loaded.emplace(path, same->second);
+      return same->second;
+    }
+  }
   try {
     mesh.textures.push_back(load_texture(path));
   } catch (const input_error& e) {
     throw input_error(mtl_path, line, std::string(statement) + ": " + e.what());
   }
   loaded.emplace(path, int(mesh.textures.size()) - 1);
+  if (!identity.empty()) loaded.emplace(identity, int(mesh.textures.size()) - 1);
   return int(mesh.textures.size()) - 1;
 }
 
@@ -273,14 +289,15 @@ struct string_view_buf : std::streambuf {
 // Parses the clean text with tinyobjloader (LoadObj, the parser behind ObjReader) and checks it read what the
 // validator saw.
 static tinyobj_result parse_clean(const std::string& path, const obj_clean_data& clean) {
-  string_view_buf obj_buf(clean.obj_text), mtl_buf(clean.mtl_text);
-  std::istream obj_in(&obj_buf), mtl_in(&mtl_buf);
-  tinyobj::MaterialStreamReader mtl_reader(mtl_in);
+  // No materials: the validator parsed the real MTL files, and the faces' materials are clean.face_materials (a
+  // placeholder library of one material per name cost tinyobjloader 1.9 KB each: 760 MB for 400k names).
+  string_view_buf obj_buf(clean.obj_text);
+  std::istream obj_in(&obj_buf);
   tinyobj_result r;
-  std::vector<tinyobj::material_t> materials;  // names u<k> only: the validator parsed the real MTL files
+  std::vector<tinyobj::material_t> materials;
   std::string warn, err;
   // triangulate = false: its ear clipping loses or flips triangles of concave polygons, so we triangulate.
-  if (!tinyobj::LoadObj(&r.attrib, &r.shapes, &materials, &warn, &err, &obj_in, &mtl_reader, false, false))
+  if (!tinyobj::LoadObj(&r.attrib, &r.shapes, &materials, &warn, &err, &obj_in, nullptr, false, false))
     throw std::logic_error(path + ": tinyobjloader rejected validated text: " + err);
   const auto& a = r.attrib;
   size_t faces = 0, corners = 0;
@@ -289,7 +306,7 @@ static tinyobj_result parse_clean(const std::string& path, const obj_clean_data&
   for (const auto& s : r.shapes) {
     for (size_t f = 0; same && f < s.mesh.num_face_vertices.size(); f++, faces++) {
       same = faces < clean.face_sizes.size() && s.mesh.num_face_vertices[f] == (clean.face_sizes[faces] & 0xff) &&
-             s.mesh.material_ids[f] == clean.face_materials[faces];
+             s.mesh.material_ids[f] == -1;
       corners += size_t(same ? clean.face_sizes[faces] : 0);
     }
     same = same && corners == s.mesh.indices.size();
@@ -315,22 +332,55 @@ corner_key triangle_corner_key(const std::vector<vec3f>& positions, const int* c
   return key;
 }
 
-// Drops emissive triangles that repeat an earlier emissive one exactly (the same three corners in the same cyclic
-// order: the same side emits): light sampling would count every copy while a ray sees one, so next-event and
-// BSDF-sampled estimates of that light would disagree. Returns how many were dropped. Keeps file order.
-static int drop_repeated_emitters(mesh_data& mesh, const std::vector<vec3f>& pos, const std::vector<char>& emissive) {
+// Drops triangles that repeat another exactly (the same three corners in the same cyclic order: the same side).
+// An emissive repeat would be counted by light sampling once per copy while a ray sees one (next-event and
+// BSDF-sampled estimates of that light would disagree); any repeat makes rays test every copy (Embree cannot split
+// identical boxes: 400k copies cost a millisecond per ray) and leaves which copy a ray reports, with its material,
+// to the traversal. Of each set of repeats the first emissive one stays, else the first. Keeps file order. Returns
+// the emissive and the other triangles dropped.
+static std::pair<int, int> drop_repeated_triangles(mesh_data& mesh, const std::vector<vec3f>& pos,
+                                                   const std::vector<char>& emissive) {
   size_t n = mesh.tri_materials.size();
-  auto key = [&](size_t t) { return triangle_corner_key(pos, &mesh.tri_positions[3 * t]); };
-  std::vector<std::pair<std::array<uint32_t, 9>, uint32_t>> keys;
-  for (size_t t = 0; t < n; t++)
-    if (emissive[size_t(mesh.tri_materials[t])]) keys.push_back({key(t), uint32_t(t)});
-  if (keys.size() < 2) return 0;
-  std::sort(keys.begin(), keys.end());
+  auto is_emissive = [&](size_t t) { return emissive[size_t(mesh.tri_materials[t])] != 0; };
+  // Grouped by a hash of the corner set (cheap; exact keys are compared within a group only).
+  std::vector<std::pair<uint64_t, uint32_t>> groups(n);
+  for (size_t t = 0; t < n; t++) {
+    uint64_t h = 0;
+    for (int i = 0; i < 3; i++) {
+      vec3f p = pos[size_t(mesh.tri_positions[3 * t + size_t(i)])] + vec3f{0, 0, 0};  // (-0 as +0)
+      uint32_t b[3];
+      std::memcpy(b, &p, sizeof b);
+      h += mix64((uint64_t(b[0]) << 32 | b[1]) ^ mix64(b[2]));
+    }
+    groups[t] = {h, uint32_t(t)};
+  }
+  std::sort(groups.begin(), groups.end());
   std::vector<char> drop(n, 0);
-  int dropped = 0;
-  for (size_t i = 1; i < keys.size(); i++)
-    if (keys[i].first == keys[i - 1].first) drop[keys[i].second] = 1, dropped++;  // sorted by index within a key
-  if (dropped == 0) return 0;
+  std::vector<std::pair<corner_key, uint32_t>> keys;
+  std::pair<int, int> dropped{0, 0};
+  for (size_t g = 0, e; g < n; g = e) {
+    for (e = g + 1; e < n && groups[e].first == groups[g].first;) e++;
+    if (e - g < 2) continue;
+    keys.clear();
+    for (size_t k = g; k < e; k++)
+      keys.push_back({triangle_corner_key(pos, &mesh.tri_positions[3 * size_t(groups[k].second)]), groups[k].second});
+    std::sort(keys.begin(), keys.end());  // by key, then by triangle
+    for (size_t a = 0, b; a < keys.size(); a = b) {
+      for (b = a + 1; b < keys.size() && keys[b].first == keys[a].first;) b++;
+      size_t keep = a;
+      for (size_t k = a; k < b; k++)
+        if (is_emissive(keys[k].second)) {
+          keep = k;
+          break;
+        }
+      for (size_t k = a; k < b; k++)
+        if (k != keep) {
+          drop[keys[k].second] = 1;
+          (is_emissive(keys[k].second) ? dropped.first : dropped.second)++;
+        }
+    }
+  }
+  if (dropped.first + dropped.second == 0) return dropped;
   size_t out = 0;
   for (size_t t = 0; t < n; t++) {
     if (drop[t]) continue;
@@ -368,7 +418,7 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
       corner_pos.resize(size_t(n));
       for (int i = 0; i < n; i++) corner_pos[size_t(i)] = position(size_t(c[i].vertex_index));
       triangulate_polygon(corner_pos, st, local);
-      int material = s.mesh.material_ids[f] >= 0 ? s.mesh.material_ids[f] : default_material;
+      int material = clean.face_materials[face] >= 0 ? clean.face_materials[face] : default_material;
       for (size_t t = 0; t < local.size(); t += 3) {
         const tinyobj::index_t* tc[3] = {&c[local[t]], &c[local[t + 1]], &c[local[t + 2]]};
         if (!good_triangle(position(size_t(tc[0]->vertex_index)), position(size_t(tc[1]->vertex_index)),
@@ -389,9 +439,13 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   }
   std::vector<char> emissive(clean.materials.size() + 1, 0);  // the last: the default material
   for (size_t k = 0; k < clean.materials.size(); k++) emissive[k] = !is_black(clean.materials[k].material.ke);
-  if (int repeated = drop_repeated_emitters(mesh, clean.positions, emissive))
+  auto [repeated, copies] = drop_repeated_triangles(mesh, clean.positions, emissive);
+  if (repeated > 0)
     std::cerr << "warning: " << path << ": dropped " << repeated << " emissive triangle" << (repeated > 1 ? "s" : "")
               << " repeating an earlier one (same corners, same side), which would light the scene once per copy\n";
+  if (copies > 0)
+    std::cerr << "warning: " << path << ": dropped " << copies << " triangle" << (copies > 1 ? "s" : "")
+              << " repeating another (same corners, same side; an emissive one is kept first, else the first)\n";
   if (st.fan_fallbacks > 0)
     std::cerr << "warning: " << path << ": " << st.fan_fallbacks
               << " polygon(s) too complex to ear-clip in the time budget were fan-triangulated\n";

@@ -585,8 +585,7 @@ obj_clean_data validate_obj(const std::string& path) {
         st.used_short_names.push_back(named.size() != t.size() ? join_from(t, 1) : std::string());
         st.used_lines.push_back(lines.line);
       }
-      current = it->second;
-      body += "usemtl u" + std::to_string(current) + "\n";
+      current = it->second;  // (faces carry it in face_materials: tinyobjloader is given no materials)
     } else if (k == "mtllib") {
       handle_mtllib(t, dir, st, pos);
     } else if (k == "o" || k == "g" || k == "s" || k == "l" || k == "p" || k == "vp") {
@@ -598,12 +597,17 @@ obj_clean_data validate_obj(const std::string& path) {
   unknown.report(path);
   text = std::string();
 
-  // Resolve the used names (first definition wins, as in tinyobjloader) in order of first use.
+  // Resolve the used names (first definition wins, as in tinyobjloader) in order of first use. Each kind of warning
+  // names its first few cases; the rest are counted in one line (a generated file may hold 100k of them).
+  constexpr int named_warnings = 3;
   std::map<std::string, int> defined_index;
+  int redefined = 0, undefined = 0;
   for (size_t i = 0; i < st.defined.size(); i++)
-    if (!defined_index.emplace(st.defined[i].material.name, int(i)).second)
+    if (!defined_index.emplace(st.defined[i].material.name, int(i)).second && redefined++ < named_warnings)
       std::cerr << "warning: " << st.defined[i].mtl_path << ":" << st.defined[i].line << ": material "
                 << quote(st.defined[i].material.name) << " is defined again; its first definition is used\n";
+  if (redefined > named_warnings)
+    std::cerr << "warning: " << redefined - named_warnings << " more materials are defined again\n";
   for (size_t k = 0; k < st.used_names.size(); k++) {
     auto it = defined_index.find(st.used_names[k]);
     if (it == defined_index.end() && !st.used_short_names[k].empty())
@@ -613,16 +617,18 @@ obj_clean_data validate_obj(const std::string& path) {
     } else {
       // As other OBJ readers do (tinyobjloader, Blender): the faces get the default material (Kd 0.8), said once per
       // name. OBJ files often outlive or lose their MTL's entries, or name materials with no mtllib at all.
-      std::cerr << "warning: " << path << ":" << st.used_lines[k] << ": usemtl of undefined material "
-                << quote(st.used_names[k])
-                << (st.defined.empty() ? " (no material library defines any)" : "")
-                << ": its faces get the default material (Kd 0.8)\n";
+      if (undefined++ < named_warnings)
+        std::cerr << "warning: " << path << ":" << st.used_lines[k] << ": usemtl of undefined material "
+                  << quote(st.used_names[k]) << (st.defined.empty() ? " (no material library defines any)" : "")
+                  << ": its faces get the default material (Kd 0.8)\n";
       d.materials.emplace_back();
       d.materials.back().material.name = st.used_names[k];
     }
-    d.mtl_text += "newmtl u" + std::to_string(k) + "\n";
   }
-  d.obj_text = d.materials.empty() ? std::move(body) : "mtllib used.mtl\n" + body;
+  if (undefined > named_warnings)
+    std::cerr << "warning: " << path << ": " << undefined - named_warnings
+              << " more undefined materials: their faces get the default material too\n";
+  d.obj_text = std::move(body);
   return d;
 }
 

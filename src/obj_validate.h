@@ -24,8 +24,7 @@ struct mtl_material_data {
 
 // The validated OBJ: clean text for tinyobjloader and what the conversion needs beside it.
 struct obj_clean_data {
-  std::string obj_text;                      // v/vn/vt/f lines, "usemtl u<k>", "mtllib used.mtl" first if any
-  std::string mtl_text;                      // "newmtl u<k>" for k = 0..materials.size()-1
+  std::string obj_text;                      // v/vn/vt/f lines only (materials: face_materials)
   std::vector<mtl_material_data> materials;  // used materials; k = order of first usemtl in the OBJ
   std::vector<int> face_sizes;               // corners of each face, in file order
   std::vector<int> face_materials;           // k of each face, or invalid_id before any usemtl

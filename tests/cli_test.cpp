@@ -535,6 +535,24 @@ TEST_CASE("materials the renderer changes or ignores are named in a warning", "[
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK(r.output.find("box.mtl:6: material 'floor' is defined again; its first definition is used") != std::string::npos);
+  // Many of either: the first three are named, the rest counted in one line.
+  std::string many_mtl = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n", many_obj;
+  for (int i = 0; i < 10; i++) many_mtl += "newmtl floor\nKd 1 0 0\n", many_obj += "usemtl x" + std::to_string(i) + "\n";
+  write_text(s.dir / "box.mtl", many_mtl);
+  std::string obj = read_text(s.dir / "box.obj");
+  write_text(s.dir / "box.obj", obj + many_obj + "f 1 2 3\n");
+  r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "o.pfm"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  auto count = [&](const std::string& what) {
+    int n = 0;
+    for (size_t at = r.output.find(what); at != std::string::npos; at = r.output.find(what, at + 1)) n++;
+    return n;
+  };
+  CHECK(count("is defined again; its first definition is used") == 3);
+  CHECK(count("7 more materials are defined again") == 1);
+  CHECK(count("usemtl of undefined material") == 3);
+  CHECK(count("7 more undefined materials: their faces get the default material too") == 1);
 }
 
 TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
