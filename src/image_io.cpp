@@ -254,6 +254,8 @@ static image_data read_exr(const std::string& path) {
   const EXRHeader& h = exr.header;
   int rgb[3] = {find_channel(h, "R"), find_channel(h, "G"), find_channel(h, "B")};
   if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
+    if (find_channel(h, "RY") >= 0 || find_channel(h, "BY") >= 0)
+      throw input_error(path, "luminance/chroma OpenEXR files (Y, RY, BY) are not supported (write R, G, B)");
     const int y = find_channel(h, "Y");  // luminance (with alpha or others): grey
     if (y >= 0) {
       rgb[0] = rgb[1] = rgb[2] = y;

@@ -184,47 +184,43 @@ static bool unit_normal(vec3f vn, vec3f& out) {
   return is_finite(out) && length_sq(out) > 0;
 }
 
-// Index of the texture for (mtl, line, name) in mesh.textures, loading it on first use of its path.
+// Index of the texture for (mtl, line, name) in mesh.textures, loading it on first use of its file.
 static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, const std::string& mtl_path, int line,
                          const char* statement, const std::string& name) {
   if (name.empty()) return invalid_id;
   const std::string dir = fs::path(mtl_path).parent_path().string();
-  std::string path = resolve_file_name(dir, name);
-  auto it = loaded.find(path);
+  const std::string written = resolve_file_name(dir, name);
+  auto it = loaded.find(written);
   if (it != loaded.end()) return it->second;
+  std::string path = written;
   std::error_code ec;
   if (!fs::exists(path, ec)) {
     // A path from the machine that wrote the MTL (C:\Users\...\wood.png), or a name in another case: the file
-    // beside the MTL, said once per name (later references find it in `loaded` under the name as resolved).
+    // beside the MTL (a path as it stands), said once per name (later references find it in `loaded`).
     std::string beside = find_beside(dir, name);
     if (!beside.empty()) {
       std::cerr << "warning: " << mtl_path << ":" << line << ": " << statement << ": " << name
                 << " does not exist; using " << beside << "\n";
-      int index = texture_index(mesh, loaded, mtl_path, line, statement, beside);
-      loaded.emplace(path, index);
-      return index;
+      path = beside;
     }
   }
   // The same file by another name (absolute and relative, a symbolic or hard link) is decoded once: by its identity.
   struct stat st;
-  std::string identity;
+  std::string identity = path;
   if (::stat(path.c_str(), &st) == 0)
     identity = "\n" + std::to_string(uint64_t(st.st_dev)) + ":" + std::to_string(uint64_t(st.st_ino));  // no path
-  if (!identity.empty()) {
-    auto same = loaded.find(identity);
-    if (same != loaded.end()) {
-      loaded.emplace(path, same->second);
-      return same->second;
+  auto same = loaded.find(identity);
+  int index = same != loaded.end() ? same->second : int(mesh.textures.size());
+  if (same == loaded.end()) {
+    try {
+      mesh.textures.push_back(load_texture(path));
+    } catch (const input_error& e) {
+      throw input_error(mtl_path, line, std::string(statement) + ": " + e.what());
     }
+    loaded.emplace(identity, index);
   }
-  try {
-    mesh.textures.push_back(load_texture(path));
-  } catch (const input_error& e) {
-    throw input_error(mtl_path, line, std::string(statement) + ": " + e.what());
-  }
-  loaded.emplace(path, int(mesh.textures.size()) - 1);
-  if (!identity.empty()) loaded.emplace(identity, int(mesh.textures.size()) - 1);
-  return int(mesh.textures.size()) - 1;
+  loaded.emplace(written, index);
+  return index;
 }
 
 // Renumbers refs (invalid_id stays) to count only the referenced elements, in their original order; returns

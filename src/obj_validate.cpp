@@ -162,6 +162,16 @@ static bool number_grammar(string_view t, bool& exponent_too_big) {
   return i == n;
 }
 
+// Whether number t (number_grammar's) has a decimal exponent below -300.
+static bool exponent_below_300(string_view t) {
+  size_t e = t.find_first_of("eE");
+  if (e == string_view::npos || e + 1 >= t.size() || t[e + 1] != '-') return false;
+  long exponent = 0;
+  for (size_t i = e + 2; i < t.size() && t[i] >= '0' && t[i] <= '9'; i++)
+    exponent = std::min(exponent * 10 + (t[i] - '0'), 100000L);
+  return exponent > 300;
+}
+
 // Parses t as a number (see number_grammar) into out; false (with a reason) when it is not one.
 static bool try_number(string_view t, float& out, std::string* why) {
   bool too_big = false;
@@ -237,6 +247,17 @@ static string_view check_corner(string_view c, const obj_clean_data& d, const te
   if (s2 == string_view::npos || !vt.empty()) check_index(vt, int(d.texcoords.size()), "texcoord", pos);
   if (s2 != string_view::npos) check_index(c.substr(s2 + 1), int(d.normals.size()), "normal", pos);
   return c;
+}
+
+// The part of a name before its first word that starts with '#', blanks after it dropped ("" when it has none, or
+// starts with one): what the name was taken as when every '#' word started a comment.
+static std::string name_before_hash_word(const std::string& name) {
+  for (size_t i = 1; i < name.size(); i++)
+    if (name[i] == '#' && (name[i - 1] == ' ' || name[i - 1] == '\t')) {
+      size_t e = name.find_last_not_of(" \t", i - 1);
+      return e == std::string::npos ? std::string() : name.substr(0, e + 1);
+    }
+  return {};
 }
 
 // Counts unrecognised statements of one file and reports them once.
@@ -421,7 +442,8 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       std::string file = check_texture_statement(named, pos, &xf);
       // "map_Kd wood.png #2" : a file name with '#' in it when there is such a file, else a comment after the name.
       std::error_code ec;
-      if (named.size() != t.size() && t.size() >= 2 && !fs::is_regular_file(resolve_file_name(dir, file), ec))
+      if (named.size() != t.size() && t.size() >= 2 && !fs::is_regular_file(resolve_file_name(dir, file), ec) &&
+          find_beside(dir, file).empty())
         file = check_texture_statement(t, pos, &xf);
       if (k == "map_Kd") {
         cur->kd_map = file, cur->kd_map_line = int(std::min<size_t>(lines.line, INT_MAX));
@@ -484,8 +506,6 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
 struct obj_pass_state {
   std::map<std::string, int> used_index;   // usemtl name -> k
   std::vector<std::string> used_names;     // k -> name
-  std::vector<std::string> used_short_names;  // k -> the name before a '#' word in it ("" when none): "usemtl wood
-                                              // #floor" means wood when no material is named "wood #floor"
   std::vector<size_t> used_lines;          // k -> line of its first usemtl
   std::set<std::string> mtl_files;         // resolved MTL paths already read
   std::vector<mtl_material_data> defined;  // all materials of all MTL files, in load order
@@ -562,7 +582,9 @@ obj_clean_data validate_obj(const std::string& path) {
       if (k == "vt") d.texcoords.push_back({x[0], x[1]});
       size_t keep = k == "vt" ? std::min<size_t>(args, 2) : 3;
       body += k;
-      for (size_t i = 1; i <= keep; i++) (body += ' ') += t[i];
+      // (A number whose exponent is below -300 is 0, said as such: tinyobjloader's exponent parser overflows an
+      // int on ten digits; its value is never read, the positions are ours.)
+      for (size_t i = 1; i <= keep; i++) (body += ' ') += exponent_below_300(t[i]) ? string_view("0") : t[i];
       body += '\n';
     } else if (k == "f") {
       if (args < 3) fail(pos, "a face needs at least 3 vertices, got " + std::to_string(args));
@@ -582,7 +604,6 @@ obj_clean_data validate_obj(const std::string& path) {
       auto it = st.used_index.emplace(name, int(st.used_names.size())).first;
       if (it->second == int(st.used_names.size())) {
         st.used_names.push_back(name);
-        st.used_short_names.push_back(named.size() != t.size() ? join_from(t, 1) : std::string());
         st.used_lines.push_back(lines.line);
       }
       current = it->second;  // (faces carry it in face_materials: tinyobjloader is given no materials)
@@ -601,17 +622,35 @@ obj_clean_data validate_obj(const std::string& path) {
   // names its first few cases; the rest are counted in one line (a generated file may hold 100k of them).
   constexpr int named_warnings = 3;
   std::map<std::string, int> defined_index;
-  int redefined = 0, undefined = 0;
+  int redefined = 0, undefined = 0, approximate = 0;
   for (size_t i = 0; i < st.defined.size(); i++)
     if (!defined_index.emplace(st.defined[i].material.name, int(i)).second && redefined++ < named_warnings)
       std::cerr << "warning: " << st.defined[i].mtl_path << ":" << st.defined[i].line << ": material "
                 << quote(st.defined[i].material.name) << " is defined again; its first definition is used\n";
   if (redefined > named_warnings)
     std::cerr << "warning: " << redefined - named_warnings << " more materials are defined again\n";
+  // A name with a '#' word that matches nothing may have meant a comment after the name, on either side: "usemtl
+  // wood #planks" and "newmtl red #red paint" (before, every '#' word started a comment): the names before the
+  // '#' words are tried too, the used one against the defined ones, then against the defined ones' (first wins).
+  std::map<std::string, int> short_index;
+  for (size_t i = 0; i < st.defined.size(); i++) {
+    std::string cut = name_before_hash_word(st.defined[i].material.name);
+    if (!cut.empty() && cut != st.defined[i].material.name) short_index.emplace(cut, int(i));
+  }
   for (size_t k = 0; k < st.used_names.size(); k++) {
     auto it = defined_index.find(st.used_names[k]);
-    if (it == defined_index.end() && !st.used_short_names[k].empty())
-      it = defined_index.find(st.used_short_names[k]);
+    const std::string used_cut = name_before_hash_word(st.used_names[k]);
+    if (it == defined_index.end() && !used_cut.empty() && used_cut != st.used_names[k])
+      it = defined_index.find(used_cut);
+    if (it == defined_index.end()) {
+      auto cut = short_index.find(used_cut.empty() ? st.used_names[k] : used_cut);
+      if (cut != short_index.end()) it = cut;
+    }
+    if (it != defined_index.end() && st.defined[size_t(it->second)].material.name != st.used_names[k] &&
+        approximate++ < named_warnings)
+      std::cerr << "warning: " << path << ":" << st.used_lines[k] << ": usemtl " << quote(st.used_names[k])
+                << " takes material " << quote(st.defined[size_t(it->second)].material.name)
+                << " (no exact match; the names agree before their '#' words)\n";
     if (it != defined_index.end()) {
       d.materials.push_back(st.defined[size_t(it->second)]);
     } else {
@@ -625,6 +664,9 @@ obj_clean_data validate_obj(const std::string& path) {
       d.materials.back().material.name = st.used_names[k];
     }
   }
+  if (approximate > named_warnings)
+    std::cerr << "warning: " << path << ": " << approximate - named_warnings
+              << " more usemtl names take a material whose name agrees before its '#' word\n";
   if (undefined > named_warnings)
     std::cerr << "warning: " << path << ": " << undefined - named_warnings
               << " more undefined materials: their faces get the default material too\n";

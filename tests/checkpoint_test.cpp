@@ -227,6 +227,25 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
 
 }  // namespace
 
+TEST_CASE("the checkpoint fingerprint sees every texture option of every material", "[checkpoint]") {
+  // -s, -o and -clamp change the image: a checkpoint of one must not resume with another.
+  camera_params cam;
+  scene_data scene = build_scene(boxed_lamp_mesh(), cam, sun_params{}, false, 1.0f);
+  REQUIRE(!scene.mesh.materials.empty());
+  render_params p;
+  const uint64_t base = render_fingerprint(scene, p);
+  for (int map = 0; map < 2; map++)
+    for (int field = 0; field < 5; field++) {
+      scene_data changed = scene;
+      texture_transform& t = map == 0 ? changed.mesh.materials[0].kd_map : changed.mesh.materials[0].alpha_map;
+      float* v[4] = {&t.scale.x, &t.scale.y, &t.offset.x, &t.offset.y};
+      if (field < 4) *v[field] += 0.5f;
+      else t.clamp = true;
+      INFO("map " << map << ", field " << field);
+      CHECK(render_fingerprint(changed, p) != base);
+    }
+}
+
 TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed", "[checkpoint]") {
   // Indices out of range crashed the resumed render, a full pending table or a pair whose parent has a parent made it
   // loop for ever, non-finite film values gave NaN pixels: each is an input error naming the file now.

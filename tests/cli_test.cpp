@@ -535,6 +535,14 @@ TEST_CASE("materials the renderer changes or ignores are named in a warning", "[
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK(r.output.find("box.mtl:6: material 'floor' is defined again; its first definition is used") != std::string::npos);
+  // Textures the renderer does not use: named in one line, with the line of each kind's first.
+  write_text(s.dir / "box.mtl", "newmtl floor\nKd 0.5 0.5 0.5\nmap_Ke glow.png\nbump -bm 2 b.png\nnewmtl lamp\n"
+                                "Kd 0 0 0\nKe 5 5 5\nmap_Ke other.png\n");
+  r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "o.pfm"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("box.mtl: textures other than map_Kd and map_d are not rendered: map_Ke (line 3), bump (line 4)\n") !=
+        std::string::npos);
   // Many of either: the first three are named, the rest counted in one line.
   std::string many_mtl = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n", many_obj;
   for (int i = 0; i < 10; i++) many_mtl += "newmtl floor\nKd 1 0 0\n", many_obj += "usemtl x" + std::to_string(i) + "\n";

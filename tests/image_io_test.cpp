@@ -239,6 +239,9 @@ TEST_CASE("EXR files in any line order, and grey ones with alpha, read as writte
   image_data ya = read_image(dir / "ya.exr");
   REQUIRE(ya.pixels.size() == size_t(w * h * 3));
   for (int i = 0; i < w * h * 3; ++i) CHECK(ya.pixels[size_t(i)] == lum[size_t(i / 3)]);
+  // Luminance/chroma (Y with RY and BY): not grey, refused.
+  write_file_atomic(dir / "yc.exr", handmade_exr(w, h, {"BY", "RY", "Y"}, {alpha, alpha, lum}, 0));
+  CHECK_THAT(read_error(dir / "yc.exr"), Catch::Contains("luminance/chroma"));
   // Two channels, neither R, G, B nor Y: refused, naming what the file has.
   write_file_atomic(dir / "uv.exr", handmade_exr(w, h, {"U", "V"}, {alpha, lum}, 0));
   CHECK_THAT(read_error(dir / "uv.exr"), Catch::Contains("found: U, V"));

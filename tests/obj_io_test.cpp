@@ -4,6 +4,7 @@
 #include "errors.h"
 #include "material.h"
 #include "obj_io.h"
+#include "obj_validate.h"
 #include "scene.h"
 
 #include <catch2/catch.hpp>
@@ -398,12 +399,19 @@ TEST_CASE("material and texture names may hold '#' words; a lone '#' starts a co
   dir.write("m.mtl",
             "newmtl Material #1\nKd 1 0 0\nnewmtl Material #2\nKd 0 1 0\n"
             "newmtl wood # the floor\nKd 0 0 1\nmap_Kd Wood #2.png\n"
-            "newmtl plain\nKd 0.5 0.5 0.5\nmap_Kd plain.png #no such file: a comment\n");
+            "newmtl plain\nKd 0.5 0.5 0.5\nmap_Kd plain.png #no such file: a comment\n"
+            "newmtl red #red paint\nKd 0.7 0 0\nmap_Kd C:\\Users\\artist\\Wood #2.png\n");
   auto obj = dir.write("m.obj", "mtllib m.mtl\n" + std::string(square_vertices) +
                                     "usemtl Material #1\nf 1 2 3\nusemtl Material #2\nf 1 3 4\n"
-                                    "usemtl wood #planks\nf 1 2 4\nusemtl plain # comment\nf 2 3 4\n");
+                                    "usemtl wood #planks\nf 1 2 4\nusemtl plain # comment\nf 2 3 4\n"
+                                    "v 5 5 5\nusemtl red\nf 1 2 5\n");
   mesh_data m = load_obj(obj);
-  REQUIRE(m.materials.size() == 4);
+  REQUIRE(m.materials.size() == 5);
+  // "usemtl red" meant "newmtl red #red paint" (a comment after the name, as the '#' word was read before).
+  CHECK(m.materials[4].name == "red #red paint");
+  CHECK(m.materials[4].kd.x == 0.7f);
+  // A '#' word in a name written on another machine: the whole name, found beside the MTL.
+  CHECK(m.materials[4].kd_texture == m.materials[2].kd_texture);
   CHECK(m.materials[0].name == "Material #1");
   CHECK(m.materials[0].kd.x == 1.0f);
   CHECK(m.materials[1].name == "Material #2");
@@ -425,6 +433,16 @@ TEST_CASE("files named with another machine's path or in another case are found 
                         "newmtl b\nmap_d leaf.PNG\nmap_Kd /home/someone/wood.png\n");
   auto obj = dir.write("p.obj", "mtllib D:\\work\\lib2.mtl\n" + std::string(square_vertices) +
                                     "vt 0.25 0.5\nusemtl a\nf 1/1 2/1 3/1\nusemtl b\nf 1/1 3/1 4/1\n");
+  // Also through a relative path with folders (the path found beside was resolved against the folder again, and
+  // again: unbounded recursion, a segfault).
+  const std::string relative = std::filesystem::relative(obj).string();
+  REQUIRE(relative.find('/') != std::string::npos);
+  for (const std::string& name : {obj, relative}) {
+    INFO(name);
+    mesh_data r = load_obj(name);
+    REQUIRE(r.textures.size() == 2);
+    CHECK(std::filesystem::equivalent(r.textures[0].path, dir.path + "/wood.png"));
+  }
   mesh_data m = load_obj(obj);
   REQUIRE(m.materials.size() == 2);
   REQUIRE(m.textures.size() == 2);  // wood.png once, for both names that lead to it
@@ -671,6 +689,8 @@ TEST_CASE("hostile input ends in an input error or a mesh", "[obj]") {
   CHECK_THAT(load_error(dir.write("exp.obj", "v 1e99999999999999 0 0\n")), Catch::Contains("out of range"));
   // A negative exponent of any size is a number that rounds to 0 (C programs print denormals as 1e-310).
   mesh_data tiny = load_obj(dir.write("tiny.obj", "v 0 0 0\nv 1 1e-310 0\nv 0 1 -1e-99999999999999\nf 1 2 3\n"));
+  // tinyobjloader is given 0 for them (its exponent parser overflows an int on ten digits).
+  CHECK(validate_obj(dir.path + "/tiny.obj").obj_text.find("e-") == std::string::npos);
   REQUIRE(triangle_count(tiny) == 1);
   CHECK(corner(tiny, 0, 1).y == 0.0f);
   CHECK(corner(tiny, 0, 2).z == 0.0f);
