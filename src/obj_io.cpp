@@ -107,11 +107,11 @@ static void ear_clip(const std::vector<double>& x, const std::vector<double>& y,
 
 // The polygon corner with the smallest position (x, then y, then z; the first of equal ones): a choice that does
 // not depend on where the corner list starts or which way it runs.
+static bool corner_less(vec3f a, vec3f b) { return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z; }
 static int smallest_corner(const std::vector<vec3f>& p) {
-  auto less = [](vec3f a, vec3f b) { return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z; };
   int m = 0;
   for (int i = 1; i < int(p.size()); i++)
-    if (less(p[size_t(i)], p[size_t(m)])) m = i;
+    if (corner_less(p[size_t(i)], p[size_t(m)])) m = i;
   return m;
 }
 
@@ -163,7 +163,24 @@ static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& 
     for (int i = 1; i + 1 < n; i++) tris.insert(tris.end(), {m, (m + i) % n, (m + i + 1) % n});
     return;
   }
-  ear_clip(x, y, st, tris);
+  // Ear clipping depends on where it starts and which way it goes: it runs on the corners from the smallest one on,
+  // toward its smaller neighbour, so a polygon and its reverse clip the same sequence and give exact reversed twins
+  // (the triangles of the reverse get their winding back).
+  int m = smallest_corner(p);
+  bool forward = !corner_less(p[size_t((m + n - 1) % n)], p[size_t((m + 1) % n)]);
+  if (m == 0 && forward) return ear_clip(x, y, st, tris);
+  std::vector<vec3f> q(static_cast<size_t>(n));
+  std::vector<int> from(static_cast<size_t>(n)), canonical;
+  for (int i = 0; i < n; i++) {
+    from[size_t(i)] = forward ? (m + i) % n : (m - i + n) % n;
+    q[size_t(i)] = p[size_t(from[size_t(i)])];
+  }
+  triangulate_polygon(q, st, canonical);  // (q starts at its smallest corner and goes toward the smaller neighbour)
+  for (size_t t = 0; t + 2 < canonical.size(); t += 3) {
+    int a = from[size_t(canonical[t])], b = from[size_t(canonical[t + 1])], c = from[size_t(canonical[t + 2])];
+    if (forward) tris.insert(tris.end(), {a, b, c});
+    else tris.insert(tris.end(), {a, c, b});
+  }
 }
 
 const char* const degenerate_reason =

@@ -135,6 +135,12 @@ TEST_CASE("a rectangle and its reverse are triangulated as exact reversed twins,
                   "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4\nf 4 3 2 1\nf 2 3 4 1\nf 1 4 3 2\nf 3 2 1 4\n", 4);
   // A convex hexagon and its reverse, written from other first corners: fanned from their smallest corner, twins too.
   check_all_twins("h.obj", "v 0 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 0 2 0\nv -1 1 0\nf 3 4 5 6 1 2\nf 5 4 3 2 1 6\n", 8);
+  // Concave polygons (an L and a comb) and their reverses from other first corners: ear-clipped from the smallest
+  // corner toward its smaller neighbour, twins too.
+  check_all_twins("L.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 1 2 3 4 5 6\nf 4 3 2 1 6 5\n", 8);
+  check_all_twins("comb.obj",
+                  "v 0 0 0\nv 5 0 0\nv 5 2 0\nv 4 2 0\nv 4 1 0\nv 3 1 0\nv 3 2 0\nv 2 2 0\nv 2 1 0\nv 1 1 0\n"
+                  "v 1 2 0\nv 0 2 0\nf 3 4 5 6 7 8 9 10 11 12 1 2\nf 8 7 6 5 4 3 2 1 12 11 10 9\n", 20);
   // A lone quad has no twin, and the column stays empty.
   scene_data lone = build_scene(load_obj(dir.write("l.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4\n")),
                                 camera_params{}, sun_params{}, false, 1.0f);
