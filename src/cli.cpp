@@ -58,7 +58,7 @@ struct render_options {
   bayes_params bayes;
   std::string bayes_pmf = "second-moment";
   std::string bayes_prior = "region";
-  int frames = 1;
+  int frames = 0;  // --frames N (0: not given: no animation, names are literal)
   double frame_decay = 0.5;
   double pass_weighting = 4;
   bool independent = false;
@@ -119,7 +119,7 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.sampler.bayes = o.bayes;
   p.sampler.bayes.second_moment = o.bayes_pmf == "second-moment";
   p.sampler.bayes.region_prior = o.bayes_prior == "region";
-  p.frames = o.frames;
+  p.frames = std::max(1, o.frames);
   p.frame_decay = o.frame_decay;
   p.pass_weighting = o.pass_weighting;
   p.stratify = !o.independent;
@@ -127,22 +127,36 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   return p;
 }
 
-// Whether a path holds exactly one printf integer directive (%d, %04d, ...) and no other '%'.
+// Whether a path holds exactly one printf integer directive (%d, %04d, ...) and no other '%' but "%%" (a '%').
 bool is_frame_pattern(const std::string& p) {
-  size_t at = p.find('%');
-  if (at == std::string::npos) return false;
-  size_t k = at + 1;
-  while (k < p.size() && (std::isdigit(static_cast<unsigned char>(p[k])) != 0)) k++;
-  // A field width of at most two digits (%04d): a wider one would make names longer than a path may be.
-  return k < p.size() && k - at - 1 <= 2 && p[k] == 'd' && p.find('%', k) == std::string::npos;
+  int directives = 0;
+  for (size_t at = p.find('%'); at != std::string::npos; at = p.find('%', at)) {
+    if (at + 1 < p.size() && p[at + 1] == '%') {
+      at += 2;
+      continue;
+    }
+    size_t k = at + 1;
+    while (k < p.size() && (std::isdigit(static_cast<unsigned char>(p[k])) != 0)) k++;
+    // A field width of at most two digits (%04d): a wider one would make names longer than a path may be.
+    if (!(k < p.size() && k - at - 1 <= 2 && p[k] == 'd')) return false;
+    directives++;
+    at = k + 1;
+  }
+  return directives == 1;
 }
-// The path of frame `frame` of a frame pattern in an animation of `frames` frames. A single-frame render takes
-// the path as written, '%' and all: only --frames makes a name a pattern.
-std::string frame_path(const std::string& pattern, int frame, int frames) {
-  if (frames <= 1 || !is_frame_pattern(pattern)) return pattern;
+// The path of frame `frame` of a frame pattern when --frames was given (animated). Without it the path is taken as
+// written, '%' and all: only --frames makes a name a pattern (--frames 1 too).
+std::string frame_path(const std::string& pattern, int frame, bool animated) {
+  if (!animated || !is_frame_pattern(pattern)) return pattern;
   char buf[4096];
   std::snprintf(buf, sizeof buf, pattern.c_str(), frame);
   return buf;
+}
+// A name with its '%' written as "%%", for a frame pattern.
+static std::string escape_percent(const std::string& s) {
+  std::string out;
+  for (char c : s) out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out;
 }
 
 // Reads a reference image of the render's size.
@@ -155,30 +169,33 @@ int run_render(const render_options& o) {
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
+  const bool animated = o.frames > 0;  // --frames given: names are frame patterns (even for one frame)
   std::vector<std::string> outputs = o.outputs;
   if (outputs.empty()) {
     // SCENE.exr in the working directory ("dir/" names dir: the scene load then says what is wrong with it).
     fs::path scene = fs::path(o.scene).lexically_normal();
     if (!scene.has_filename()) scene = scene.parent_path();
     std::string stem = scene.stem().string();
-    outputs.push_back((stem.empty() || stem == "." || stem == ".." ? "render" : stem) +
-                      (o.frames > 1 ? "_%04d.exr" : ".exr"));
+    if (stem.empty() || stem == "." || stem == "..") stem = "render";
+    outputs.push_back(animated ? escape_percent(stem) + "_%04d.exr" : stem + ".exr");
   }
   for (const std::string& out : outputs)
     if (image_format_of(out) == image_format::unknown)
       throw usage_error("output " + out + ": unknown image format (use .exr, .pfm or .png)");
-  if (o.frames > 1) {
+  if (animated) {
     // Every per-frame file names its frame with a printf pattern such as out_%04d.exr.
+    const std::string how = " (one %d such as out_%04d.exr; a '%' in the name is written %%): ";
     for (const std::string& out : outputs)
-      if (!is_frame_pattern(out)) throw usage_error("--frames needs a frame pattern in -o (e.g. out_%04d.exr): " + out);
-    if (!o.log.empty() && !is_frame_pattern(o.log)) throw usage_error("--frames needs a frame pattern in --log: " + o.log);
+      if (!is_frame_pattern(out)) throw usage_error("--frames needs a frame pattern in -o" + how + out);
+    if (!o.log.empty() && !is_frame_pattern(o.log))
+      throw usage_error("--frames needs a frame pattern in --log" + how + o.log);
     if (!o.reference.empty() && !is_frame_pattern(o.reference))
-      throw usage_error("--frames needs a frame pattern in --reference: " + o.reference);
+      throw usage_error("--frames needs a frame pattern in --reference" + how + o.reference);
   }
   if (o.frames > 1 && (!o.checkpoint.empty() || !o.resume.empty()))
     throw usage_error("--checkpoint and --resume are not supported with --frames");
-  for (const std::string& out : outputs) check_output_path(frame_path(out, 0, o.frames));
-  if (!o.log.empty()) check_output_path(frame_path(o.log, 0, o.frames));
+  for (const std::string& out : outputs) check_output_path(frame_path(out, 0, animated));
+  if (!o.log.empty()) check_output_path(frame_path(o.log, 0, animated));
   if (!o.checkpoint.empty()) check_output_path(o.checkpoint);
   std::string resume_bytes;
   if (!o.resume.empty()) resume_bytes = read_file(o.resume);
@@ -192,7 +209,7 @@ int run_render(const render_options& o) {
   std::vector<image_data> references;
   if (!o.reference.empty())
     for (int f = 0; f < params.frames; f++)
-      references.push_back(load_reference(frame_path(o.reference, f, o.frames), params));
+      references.push_back(load_reference(frame_path(o.reference, f, animated), params));
   for (const image_data& r : references) params.frame_references.push_back(&r);
   auto t_load = std::chrono::steady_clock::now();
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
@@ -200,9 +217,9 @@ int run_render(const render_options& o) {
   {
     std::vector<std::pair<std::string, std::string>> outs, ins = {{o.scene, "scene file"}};
     for (int f = 0; f < params.frames; f++) {
-      for (const std::string& out : outputs) outs.push_back({frame_path(out, f, o.frames), "output"});
-      if (!o.log.empty()) outs.push_back({frame_path(o.log, f, o.frames), "log"});
-      if (!o.reference.empty()) ins.push_back({frame_path(o.reference, f, o.frames), "reference"});
+      for (const std::string& out : outputs) outs.push_back({frame_path(out, f, animated), "output"});
+      if (!o.log.empty()) outs.push_back({frame_path(o.log, f, animated), "log"});
+      if (!o.reference.empty()) ins.push_back({frame_path(o.reference, f, animated), "reference"});
     }
     if (!o.checkpoint.empty()) outs.push_back({o.checkpoint, "checkpoint"});
     for (const std::string& src : scene.mesh.source_files) ins.push_back({src, "scene input"});
@@ -275,12 +292,12 @@ int run_render(const render_options& o) {
   bool interrupted = false;
   render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
     std::vector<std::string> files;
-    for (const std::string& out : outputs) files.push_back(frame_path(out, frame, o.frames));
+    for (const std::string& out : outputs) files.push_back(frame_path(out, frame, animated));
     if (result.spp > 0) {
       image_data img = film_image(result);
       for (const std::string& f : files) write_image(f, img);
     }
-    if (!o.log.empty()) write_file_atomic(frame_path(o.log, frame, o.frames), pass_log_csv(o.sampler, result.log));
+    if (!o.log.empty()) write_file_atomic(frame_path(o.log, frame, animated), pass_log_csv(o.sampler, result.log));
     if (!o.quiet || result.interrupted) {
       std::string prefix = params.frames > 1 ? "frame " + std::to_string(frame) + ": " : "";
       std::fprintf(stderr, "%s%s\n", prefix.c_str(), render_summary(result, files).c_str());
@@ -456,7 +473,8 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse")->check(file_name);
   r->add_option("--frames", o.frames,
                 "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
-                "and --reference then take a frame pattern such as out_%04d.exr")
+                "and --reference then take a frame pattern such as out_%04d.exr (default output SCENE_%04d.exr; "
+                "without --frames names are literal)")
       ->check(CLI::Range(1, 100000));
   r->add_option("--checkpoint", o.checkpoint,
                 "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
@@ -548,7 +566,7 @@ int run_compare_command(const compare_options& o) {
   }
   if (cp.samplers.empty()) throw usage_error("--samplers names no sampler");
   if ((o.render.spp > 0) == (o.render.time > 0)) throw usage_error("compare needs exactly one of --time and --spp");
-  if (o.render.frames > 1 || !o.render.checkpoint.empty() || !o.render.resume.empty())
+  if (o.render.frames > 0 || !o.render.checkpoint.empty() || !o.render.resume.empty())
     throw usage_error("--frames, --checkpoint and --resume are options of render, not of compare");
   scene_desc desc = load_scene_desc(o.render.scene);
   cp.render = resolve_params(o.render, desc, cp.samplers[0]);

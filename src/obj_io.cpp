@@ -349,12 +349,15 @@ corner_key triangle_corner_key(const std::vector<vec3f>& positions, const int* c
 // An emissive repeat would be counted by light sampling once per copy while a ray sees one (next-event and
 // BSDF-sampled estimates of that light would disagree); any repeat makes rays test every copy (Embree cannot split
 // identical boxes: 400k copies cost a millisecond per ray) and leaves which copy a ray reports, with its material,
-// to the traversal. Of each set of repeats the first emissive one stays, else the first. Keeps file order. Returns
-// the emissive and the other triangles dropped.
+// to the traversal. Of each set of repeats the first emissive one stays, else the first. Where a copy has a map_d
+// cut-out, only emissive copies after the first emissive one go: a ray through a hole of one copy goes on to the
+// other at the same distance, so together they are as solid as the solid one. Keeps file order. Returns the
+// emissive and the other triangles dropped.
 static std::pair<int, int> drop_repeated_triangles(mesh_data& mesh, const std::vector<vec3f>& pos,
-                                                   const std::vector<char>& emissive) {
+                                                   const std::vector<char>& emissive, const std::vector<char>& cutout) {
   size_t n = mesh.tri_materials.size();
   auto is_emissive = [&](size_t t) { return emissive[size_t(mesh.tri_materials[t])] != 0; };
+  auto has_cutout = [&](size_t t) { return cutout[size_t(mesh.tri_materials[t])] != 0; };
   // Grouped by a hash of the corner set (cheap; exact keys are compared within a group only).
   std::vector<std::pair<uint64_t, uint32_t>> groups(n);
   for (size_t t = 0; t < n; t++) {
@@ -386,8 +389,10 @@ static std::pair<int, int> drop_repeated_triangles(mesh_data& mesh, const std::v
           keep = k;
           break;
         }
+      bool holes = false;
+      for (size_t k = a; k < b; k++) holes = holes || has_cutout(keys[k].second);
       for (size_t k = a; k < b; k++)
-        if (k != keep) {
+        if (k != keep && (!holes || (is_emissive(keys[k].second) && is_emissive(keys[keep].second)))) {
           drop[keys[k].second] = 1;
           (is_emissive(keys[k].second) ? dropped.first : dropped.second)++;
         }
@@ -452,7 +457,9 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   }
   std::vector<char> emissive(clean.materials.size() + 1, 0);  // the last: the default material
   for (size_t k = 0; k < clean.materials.size(); k++) emissive[k] = !is_black(clean.materials[k].material.ke);
-  auto [repeated, copies] = drop_repeated_triangles(mesh, clean.positions, emissive);
+  std::vector<char> cutout(clean.materials.size() + 1, 0);
+  for (size_t k = 0; k < clean.materials.size(); k++) cutout[k] = !clean.materials[k].alpha_map.empty();
+  auto [repeated, copies] = drop_repeated_triangles(mesh, clean.positions, emissive, cutout);
   if (repeated > 0)
     std::cerr << "warning: " << path << ": dropped " << repeated << " emissive triangle" << (repeated > 1 ? "s" : "")
               << " repeating an earlier one (same corners, same side), which would light the scene once per copy\n";

@@ -101,11 +101,22 @@ scene_data build_scene(const scene_desc& desc, float aspect) {
                                        "give the camera's \"eye\" and \"target\" in a scene file, or a wider "
                                        "\"fov_y_deg\"");
     }
+  const camera_params& c = desc.camera;
   vec3f dir = s.camera.target - s.camera.eye;
-  if (!(length(normalize(dir)) > 0))
-    throw input_error(desc.path, "the camera's \"eye\" is the mesh's centre, its default \"target\": give a target");
-  if (!(length(cross(normalize(dir), normalize(s.camera.up))) > 1e-6f))
-    throw input_error(desc.path, "camera \"up\" must not be parallel to the viewing direction");
+  if (!(length(normalize(dir)) > 0)) {
+    if (c.frame_eye)
+      throw input_error(desc.path, c.target_line,
+                        "the camera's \"eye\", framed from the mesh bounds toward the given \"target\", rounds onto it "
+                        "in float (a target this far from the origin for a mesh this small): give an \"eye\" too");
+    throw input_error(desc.path, c.eye_line,
+                      "the camera's \"eye\" is the mesh's centre, its default \"target\": give a target");
+  }
+  if (!(length(cross(normalize(dir), normalize(s.camera.up))) > 1e-6f)) {
+    if (c.up_given)
+      throw input_error(desc.path, c.up_line, "camera \"up\" must not be parallel to the viewing direction");
+    throw input_error(desc.path, c.camera_line,
+                      "the default camera \"up\", [0, 1, 0], is parallel to the viewing direction: give an \"up\"");
+  }
   return s;
 }
 

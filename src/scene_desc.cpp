@@ -24,17 +24,45 @@ using json = nlohmann::json;
 
 namespace {
 
+// A message part of at most 200 characters (a 1 MB number literal was echoed whole).
+std::string shorten(const std::string& s) { return s.size() <= 200 ? s : s.substr(0, 200) + "..."; }
+
 // The text of the scene file and helpers to raise errors pointing into it.
 struct desc_context {
   std::string path;
   std::string text;
 
-  // 1-based line of the first occurrence of "key" in the file (0 when not found).
-  int line_of(const std::string& key) const {
-    size_t at = text.find("\"" + key + "\"");
-    if (at == std::string::npos) return 0;
+  // Offset of the first quoted string equal to "key" at or after `from` that is not inside a // or /* */ comment
+  // (a commented-out old value must not take the line), or npos.
+  size_t find_quoted(const std::string& key, size_t from = 0) const {
+    const std::string quoted = "\"" + key + "\"";
+    size_t i = 0, n = text.size();
+    while (i < n) {
+      if (text[i] == '/' && i + 1 < n && text[i + 1] == '/') {
+        i = text.find('\n', i);
+        if (i == std::string::npos) return i;
+      } else if (text[i] == '/' && i + 1 < n && text[i + 1] == '*') {
+        i = text.find("*/", i + 2);
+        if (i == std::string::npos) return i;
+        i += 2;
+      } else if (text[i] == '"') {
+        size_t j = i + 1;
+        while (j < n && text[j] != '"') j += text[j] == '\\' ? 2 : 1;
+        if (i >= from && text.compare(i, quoted.size(), quoted) == 0 && j == i + quoted.size() - 1) return i;
+        i = j + 1;
+      } else {
+        i++;
+      }
+    }
+    return std::string::npos;
+  }
+  // 1-based line of an offset into the text (0 for npos).
+  int line_at(size_t at) const {
+    if (at == std::string::npos || at > text.size()) return 0;
     return 1 + int(std::count(text.begin(), text.begin() + long(at), '\n'));
   }
+  // 1-based line of the first occurrence of "key" in the file outside comments (0 when not found).
+  int line_of(const std::string& key) const { return line_at(find_quoted(key)); }
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw input_error(path, line_of(key), what);
   }
@@ -106,6 +134,11 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   cam.frame_target = has_eye && !has_target;
   if (has_eye) cam.eye = get_vec3(ctx, j["eye"], "eye");
   if (has_target) cam.target = get_vec3(ctx, j["target"], "target");
+  cam.camera_line = ctx.line_of("camera");
+  cam.eye_line = has_eye ? ctx.line_of("eye") : 0;
+  cam.target_line = has_target ? ctx.line_of("target") : 0;
+  cam.up_given = j.contains("up");
+  cam.up_line = cam.up_given ? ctx.line_of("up") : 0;
   // Embree refuses ray origins beyond about 1.8e18 (a camera framed from a target-only key sits near its target);
   // no mesh that keeps a triangle reaches 1e17 (float spacing there exceeds any triangle whose area is finite).
   auto within_range = [&](bool given, vec3f v, const std::string& key) {
@@ -145,8 +178,10 @@ void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
     ctx.fail("irradiance", "sun \"irradiance\" must not be negative");
   if (j.contains("angular_diameter_deg"))
     sun.angular_diameter_deg = get_number(ctx, j["angular_diameter_deg"], "angular_diameter_deg");
-  if (!(sun.angular_diameter_deg > 0 && sun.angular_diameter_deg < 90))
-    ctx.fail("angular_diameter_deg", "sun \"angular_diameter_deg\" must be in (0, 90)");
+  // (180: a half-angle of 90 degrees, the whole sky on the sun's side; a wider disk would reach below the horizon of a
+  // surface facing it, which its irradiance could not then describe.)
+  if (!(sun.angular_diameter_deg > 0 && sun.angular_diameter_deg <= 180))
+    ctx.fail("angular_diameter_deg", "sun \"angular_diameter_deg\" must be in (0, 180]");
   // The disk's radiance (irradiance over its projected solid angle) must stay far inside float's range.
   double omc = sun_one_minus_cos(sun.angular_diameter_deg);
   double radiance = double(max_component(sun.irradiance)) / (M_PI * omc * (2 - omc));
@@ -207,7 +242,7 @@ scene_desc load_scene_desc(const std::string& path) {
     int line = 1 + int(std::count(ctx.text.begin(), ctx.text.begin() + long(at), '\n'));
     std::string msg = e.what();
     size_t cut = msg.find("syntax error");
-    throw input_error(path, line, "malformed JSON: " + (cut == std::string::npos ? msg : msg.substr(cut)));
+    throw input_error(path, line, "malformed JSON: " + shorten(cut == std::string::npos ? msg : msg.substr(cut)));
   } catch (const json::exception& e) {
     // The parser's other error: out_of_range.406 for a number literal beyond double range ("1e400"). It has no
     // byte offset; the line is that of the literal quoted in the message, when the file holds it verbatim.
@@ -217,14 +252,14 @@ scene_desc load_scene_desc(const std::string& path) {
                                                               : std::string::npos;
     int line = at == std::string::npos ? 0 : 1 + int(std::count(ctx.text.begin(), ctx.text.begin() + long(at), '\n'));
     size_t tag_end = msg.find("] ");
-    throw input_error(path, line, "malformed JSON: " + (tag_end == std::string::npos ? msg : msg.substr(tag_end + 2)));
+    throw input_error(path, line,
+                      "malformed JSON: " + shorten(tag_end == std::string::npos ? msg : msg.substr(tag_end + 2)));
   }
   if (!duplicate.empty()) {
     // The line of its second appearance as a quoted string (the best a callback without offsets can tell).
-    std::string quoted = "\"" + duplicate + "\"";
-    size_t first = ctx.text.find(quoted), second = first == std::string::npos ? first : ctx.text.find(quoted, first + 1);
-    int line = second == std::string::npos ? 0 : 1 + int(std::count(ctx.text.begin(), ctx.text.begin() + long(second), '\n'));
-    throw input_error(path, line, "key \"" + duplicate + "\" is given twice in one object");
+    size_t first = ctx.find_quoted(duplicate);
+    size_t second = first == std::string::npos ? first : ctx.find_quoted(duplicate, first + 1);
+    throw input_error(path, ctx.line_at(second), "key \"" + shorten(duplicate) + "\" is given twice in one object");
   }
   check_keys(ctx, root, "the scene file", {"mesh", "camera", "image", "render", "sun", "two_sided_emitters"});
   if (!root.contains("mesh")) throw input_error(path, "missing required key \"mesh\"");
@@ -271,6 +306,7 @@ scene_desc load_scene_desc(const std::string& path) {
 
 vec3f animated_sun_direction(const sun_params& sun, int frame, int frames) {
   if (!sun.animated || frames <= 1 || frame == 0) return sun.direction;
+  if (frame == frames - 1) return sun.direction_end;  // exactly, as a scene with that direction has it
   float t = float(frame) / float(frames - 1);
   vec3f a = sun.direction, b = sun.direction_end;
   float cos_ab = clampf(dot(a, b), -1.0f, 1.0f);

@@ -19,6 +19,8 @@ struct camera_params {
   bool frame_eye = false, frame_target = false;
   vec3f eye = {0, 0, 1}, target = {0, 0, 0}, up = {0, 1, 0};
   float fov_y_deg = 45;
+  bool up_given = false;
+  int eye_line = 0, target_line = 0, up_line = 0, camera_line = 0;  // in the scene file (0: not there), for messages
 };
 
 // A distant disk light. direction points from the scene toward the sun (unit length after parsing).

@@ -66,7 +66,8 @@ TEST_CASE("each frame of a non learning sampler equals a single render with that
     REQUIRE(r.status == 0);
     for (int k = 0; k < frames; k++) {
       vec3f d = animated_sun_direction(desc.sun, k, frames);
-      std::string single = k == 0 ? anim : a.scene("single.json", d, nullptr);
+      // (The last frame as a scene written with the end direction itself: the same image, to the bit.)
+      std::string single = k == 0 ? anim : a.scene("single.json", k == frames - 1 ? sun_end : d, nullptr);
       REQUIRE(run_bayeslight("render " + single + " --sampler " + s + " --quiet -o " + (a.dir / "s.pfm")).status == 0);
       char name[32];
       std::snprintf(name, sizeof name, "f_%02d.pfm", k);
@@ -75,8 +76,10 @@ TEST_CASE("each frame of a non learning sampler equals a single render with that
     }
   }
   // The first and last frames have the start and end suns.
-  CHECK(length(animated_sun_direction(desc.sun, 0, frames) - normalize(sun_start)) < 1e-6f);
-  CHECK(length(animated_sun_direction(desc.sun, frames - 1, frames) - normalize(sun_end)) < 1e-6f);
+  auto same = [](vec3f u, vec3f v) { return u.x == v.x && u.y == v.y && u.z == v.z; };
+  CHECK(same(animated_sun_direction(desc.sun, 0, frames), desc.sun.direction));
+  CHECK(same(animated_sun_direction(desc.sun, frames - 1, frames), desc.sun.direction_end));
+  CHECK(length(desc.sun.direction_end - normalize(sun_end)) < 1e-6f);
 }
 
 TEST_CASE("learning samplers animate deterministically and agree with single renders", "[animation]") {
@@ -128,6 +131,33 @@ TEST_CASE("without --frames an output name is taken literally, % and all", "[ani
   CHECK(std::filesystem::exists(log));
   CHECK_FALSE(std::filesystem::exists(a.dir / "still_0.pfm"));
   CHECK_FALSE(std::filesystem::exists(a.dir / "still_00.csv"));
+}
+
+TEST_CASE("an animation of one frame (--frames 1) takes frame patterns, and a '%' in a name is written %%",
+          "[animation]") {
+  // A script passing --frames $N broke for N = 1: names were taken literally. A scene named with a '%' had its own
+  // default output refused as not a frame pattern.
+  anim_scene a;
+  std::string anim = a.scene("anim.json", sun_start, &sun_end);
+  auto one = run_bayeslight("render " + anim + " --frames 1 --spp 1 --quiet -o " + (a.dir / "one_%02d.pfm") +
+                            " --log " + (a.dir / "one_%d.csv"));
+  INFO(one.output);
+  REQUIRE(one.status == 0);
+  CHECK(std::filesystem::exists(a.dir / "one_00.pfm"));
+  CHECK(std::filesystem::exists(a.dir / "one_0.csv"));
+  std::filesystem::copy_file(anim, a.dir / "my%20scene.json");
+  std::string cmd = "cd " + a.dir.path.string() + " && " + BAYESLIGHT_BINARY +
+                    " render 'my%20scene.json' --frames 2 --spp 1 --quiet 2>/dev/null";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  CHECK(std::filesystem::exists(a.dir / "my%20scene_0000.exr"));
+  CHECK(std::filesystem::exists(a.dir / "my%20scene_0001.exr"));
+  // "%%" is a '%' in a pattern; two directives are not a pattern, and the message says what one is.
+  auto pct = run_bayeslight("render " + anim + " --frames 2 --spp 1 --quiet -o " + (a.dir / "p_%%_%d.pfm"));
+  REQUIRE(pct.status == 0);
+  CHECK(std::filesystem::exists(a.dir / "p_%_1.pfm"));
+  auto two = run_bayeslight("render " + anim + " --frames 2 --spp 1 --quiet -o " + (a.dir / "t_%d_%d.pfm"));
+  CHECK(two.status == 2);
+  CHECK(two.output.find("one %d such as out_%04d.exr") != std::string::npos);
 }
 
 TEST_CASE("frames of a sun that does not move are rendered with a warning", "[animation]") {

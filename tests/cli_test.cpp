@@ -262,6 +262,16 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
        "{\"mesh\": \"box.obj\", \"sun\": {\"direction\": [0,1,0], \"irradiance\": [1e30,1,1], "
        "\"angular_diameter_deg\": 1e-5}}",
        "hot_sun.json:1: sun \"irradiance\" over a disk of 1e-05 degrees is a radiance of 3.18e+41, above 1e35"},
+      // A commented-out old value does not take the line of the key's error.
+      {"commented.json", "{\"mesh\": \"box.obj\", \"render\": {\n// \"spp\": 1024,\n/* \"spp\": 8 */ \"spp\": 0}}",
+       "commented.json:3: \"spp\""},
+      // Camera errors found once the mesh is known name the line of the key at fault, and what to do.
+      {"up_line.json", "{\"mesh\": \"box.obj\",\n \"camera\": {\"target\": [0, 0, 0],\n \"up\": [0, 0, 1]}}",
+       "up_line.json:3: camera \"up\" must not be parallel"},
+      {"up_default.json", "{\"mesh\": \"box.obj\",\n \"camera\": {\"eye\": [0, 5, 0]}}",
+       "up_default.json:2: the default camera \"up\", [0, 1, 0], is parallel to the viewing direction: give an \"up\""},
+      {"far_framed.json", "{\"mesh\": \"box.obj\",\n \"camera\": {\"target\": [0, 0, 1e12]}}",
+       "far_framed.json:2: the camera's \"eye\", framed from the mesh bounds toward the given \"target\", rounds onto"},
   };
   write_text(s.dir / "bad.obj", "v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n");
   for (const auto& c : cases) {
@@ -271,6 +281,14 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
     CHECK(r.status == 3);
     CHECK(r.output.find(c.expect) != std::string::npos);
     CHECK(!exists(s.dir / "out.exr"));
+  }
+  // A 1 MB number literal or unterminated string is named, not echoed whole (the message was 1 MB).
+  for (const std::string& junk : {"1" + std::string(1'000'000, '0') + "e999", "\"" + std::string(1'000'000, 'x')}) {
+    write_text(s.dir / "long.json", "{\"mesh\": \"box.obj\", \"render\": {\"spp\": " + junk + "}}");
+    auto r = run_bayeslight("render " + (s.dir / "long.json") + " --quiet -o " + (s.dir / "out.exr"));
+    CHECK(r.status == 3);
+    CHECK(r.output.find("long.json:1: malformed JSON") != std::string::npos);
+    CHECK(r.output.size() < 1000);
   }
   // A reference of the wrong size, or not an image.
   write_text(s.dir / "garbage.exr", "not an exr");
@@ -409,6 +427,19 @@ TEST_CASE("a sun of any positive diameter gives its irradiance", "[cli]") {
     INFO("diameter " << d);
     CHECK(mean_of("tiny", d) == Approx(small).epsilon(1e-3));
   }
+  // Up to 180 degrees (the whole sky on its side; 90 and more were refused, against SPEC's "> 0").
+  for (const char* d : {"90", "120", "180"}) {
+    INFO("diameter " << d);
+    double wide = mean_of("wide", d);
+    CHECK(wide > 0);
+    CHECK(std::isfinite(wide));
+  }
+  write_text(s.dir / "over.json",
+             "{\"mesh\": \"box.obj\", \"sun\": {\"direction\": [0, 1, 0], \"irradiance\": [2, 2, 2],"
+             " \"angular_diameter_deg\": 180.5}}");
+  auto over = run_bayeslight("render " + (s.dir / "over.json") + " --spp 1 --quiet -o " + (s.dir / "over.pfm"));
+  CHECK(over.status == 3);
+  CHECK(over.output.find("must be in (0, 180]") != std::string::npos);
 }
 
 TEST_CASE("outputs that would overwrite an input or each other are refused before rendering", "[cli]") {
@@ -541,11 +572,12 @@ TEST_CASE("materials the renderer changes or ignores are named in a warning", "[
   r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "o.pfm"));
   INFO(r.output);
   REQUIRE(r.status == 0);
-  CHECK(r.output.find("box.mtl: textures other than map_Kd and map_d are not rendered: map_Ke (line 3), bump (line 4)\n") !=
-        std::string::npos);
+  CHECK(r.output.find("box.mtl: textures other than map_Kd and map_d are not rendered: map_Ke (line 3), bump (line 4)"
+                      "\n") != std::string::npos);
   // Many of either: the first three are named, the rest counted in one line.
   std::string many_mtl = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n", many_obj;
-  for (int i = 0; i < 10; i++) many_mtl += "newmtl floor\nKd 1 0 0\n", many_obj += "usemtl x" + std::to_string(i) + "\n";
+  for (int i = 0; i < 10; i++)
+    many_mtl += "newmtl floor\nKd 1 0 0\n", many_obj += "usemtl x" + std::to_string(i) + "\n";
   write_text(s.dir / "box.mtl", many_mtl);
   std::string obj = read_text(s.dir / "box.obj");
   write_text(s.dir / "box.obj", obj + many_obj + "f 1 2 3\n");

@@ -268,6 +268,19 @@ TEST_CASE("a triangle repeating another is dropped, the first emissive one kept"
   REQUIRE(triangle_count(w) == 2);
   CHECK(w.materials[size_t(w.tri_materials[0])].name == "wall");  // 1 3 4 (its repeat 3 4 1 dropped)
   CHECK(w.materials[size_t(w.tri_materials[1])].name == "lamp");  // 2 3 1 (the wall 1 2 3 before it dropped)
+  // With a cut-out among the copies both stay (a ray through a hole meets the other copy: solid together), but for
+  // emissive repeats of an emissive copy.
+  write_png(dir, "a.png");
+  dir.write("c.mtl", "newmtl leaf\nmap_d a.png\nnewmtl wall\nKd 0.5 0.5 0.5\nnewmtl lamp\nKe 5 5 5\nmap_d a.png\n");
+  auto obj3 = dir.write("c.obj", "mtllib c.mtl\n" + std::string(square_vertices) +
+                                     "usemtl leaf\nf 1 2 3\nusemtl wall\nf 1 2 3\n"
+                                     "usemtl lamp\nf 1 3 4\nf 3 4 1\nusemtl wall\nf 1 3 4\n");
+  mesh_data c = load_obj(obj3);
+  REQUIRE(triangle_count(c) == 4);  // leaf, wall; lamp, wall (the lamp's repeat dropped)
+  CHECK(c.materials[size_t(c.tri_materials[0])].name == "leaf");
+  CHECK(c.materials[size_t(c.tri_materials[1])].name == "wall");
+  CHECK(c.materials[size_t(c.tri_materials[2])].name == "lamp");
+  CHECK(c.materials[size_t(c.tri_materials[3])].name == "wall");
 }
 
 TEST_CASE("a file without usemtl has only the default material", "[obj]") {
