@@ -349,7 +349,7 @@ void add_render_options(CLI::App* r, render_options& o) {
   spp->excludes(time);
   r->add_option("--max-depth", o.max_depth,
                 "Path length in segments; 1 = direct illumination only (camera ray, NEE and emission seen), 2 adds "
-                "one bounce")
+                "one bounce (default: the scene's render.max_depth)")
       ->check(CLI::Range(1, 1000));
   r->add_option("--threads", o.threads, "Worker threads (default: all cores); never changes the image")
       ->check(CLI::Range(1, 4096));
@@ -365,8 +365,10 @@ void add_render_options(CLI::App* r, render_options& o) {
         o.seed = uint64_t(v), o.has_seed = true;
       },
       "Random seed, 0 to 2^64 - 1 (default: the scene's render.seed)");
-  r->add_option("--width", o.width, "Image width in pixels")->check(CLI::Range(1ll, max_side));
-  r->add_option("--height", o.height, "Image height in pixels")->check(CLI::Range(1ll, max_side));
+  r->add_option("--width", o.width, "Image width in pixels (default: the scene's image.width)")
+      ->check(CLI::Range(1ll, max_side));
+  r->add_option("--height", o.height, "Image height in pixels (default: the scene's image.height)")
+      ->check(CLI::Range(1ll, max_side));
   r->add_flag("--quiet", o.quiet, "No progress bar or summary");
   r->add_option("--pass-weighting", o.pass_weighting,
                 "Adaptive samplers (bayes, donikian): a pass after n spp counts (n+1)/(n+1+S) per sample, so the first "
