@@ -440,11 +440,18 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
         ignored_order.emplace_back(k);
       texture_transform xf;
       std::string file = check_texture_statement(named, pos, &xf);
-      // "map_Kd wood.png #2" : a file name with '#' in it when there is such a file, else a comment after the name.
+      // "map_Kd wood.png #2": a file name with a '#' word when there is such a file (here, or beside the MTL when the
+      // word is in its last path component: "C:\...\Wood #2.png"), else a comment after the name.
       std::error_code ec;
-      if (named.size() != t.size() && t.size() >= 2 && !fs::is_regular_file(resolve_file_name(dir, file), ec) &&
-          find_beside(dir, file).empty())
-        file = check_texture_statement(t, pos, &xf);
+      if (named.size() != t.size() && t.size() >= 2 && !fs::is_regular_file(resolve_file_name(dir, file), ec)) {
+        texture_transform cut_xf;
+        std::string cut = check_texture_statement(t, pos, &cut_xf);
+        size_t slash = file.find_last_of("/\\");
+        std::string last = slash == std::string::npos ? file : file.substr(slash + 1);
+        bool hash_in_last = !name_before_hash_word(last).empty() || (!last.empty() && last[0] == '#');
+        if (fs::is_regular_file(resolve_file_name(dir, cut), ec) || !hash_in_last || find_beside(dir, file).empty())
+          file = cut, xf = cut_xf;
+      }
       if (k == "map_Kd") {
         cur->kd_map = file, cur->kd_map_line = int(std::min<size_t>(lines.line, INT_MAX));
         cur->material.kd_map = xf;
@@ -638,21 +645,21 @@ obj_clean_data validate_obj(const std::string& path) {
     if (!cut.empty() && cut != st.defined[i].material.name) short_index.emplace(cut, int(i));
   }
   for (size_t k = 0; k < st.used_names.size(); k++) {
-    auto it = defined_index.find(st.used_names[k]);
+    int found = -1;  // index into st.defined
     const std::string used_cut = name_before_hash_word(st.used_names[k]);
-    if (it == defined_index.end() && !used_cut.empty() && used_cut != st.used_names[k])
-      it = defined_index.find(used_cut);
-    if (it == defined_index.end()) {
-      auto cut = short_index.find(used_cut.empty() ? st.used_names[k] : used_cut);
-      if (cut != short_index.end()) it = cut;
-    }
-    if (it != defined_index.end() && st.defined[size_t(it->second)].material.name != st.used_names[k] &&
-        approximate++ < named_warnings)
+    auto lookup = [&](const std::map<std::string, int>& index, const std::string& name) {
+      auto it = index.find(name);
+      if (found < 0 && it != index.end()) found = it->second;
+    };
+    lookup(defined_index, st.used_names[k]);
+    if (!used_cut.empty()) lookup(defined_index, used_cut);
+    lookup(short_index, used_cut.empty() ? st.used_names[k] : used_cut);
+    if (found >= 0 && st.defined[size_t(found)].material.name != st.used_names[k] && approximate++ < named_warnings)
       std::cerr << "warning: " << path << ":" << st.used_lines[k] << ": usemtl " << quote(st.used_names[k])
-                << " takes material " << quote(st.defined[size_t(it->second)].material.name)
+                << " takes material " << quote(st.defined[size_t(found)].material.name)
                 << " (no exact match; the names agree before their '#' words)\n";
-    if (it != defined_index.end()) {
-      d.materials.push_back(st.defined[size_t(it->second)]);
+    if (found >= 0) {
+      d.materials.push_back(st.defined[size_t(found)]);
     } else {
       // As other OBJ readers do (tinyobjloader, Blender): the faces get the default material (Kd 0.8), said once per
       // name. OBJ files often outlive or lose their MTL's entries, or name materials with no mtllib at all.

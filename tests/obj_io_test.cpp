@@ -431,6 +431,14 @@ TEST_CASE("material and texture names may hold '#' words; a lone '#' starts a co
   CHECK(m.materials[4].kd.x == 0.7f);
   // A '#' word in a name written on another machine: the whole name, found beside the MTL.
   CHECK(m.materials[4].kd_texture == m.materials[2].kd_texture);
+  // A comment holding a path after a name that exists: the name, not a file of the comment's last part found beside.
+  std::filesystem::create_directory(dir.path + "/tex");
+  write_png(dir, "tex/wood.png");
+  write_png(dir, "wood.png");
+  dir.write("c.mtl", "newmtl a\nmap_Kd tex/wood.png #was C:\\Users\\me\\textures\\wood.png\n");
+  mesh_data c = load_obj(dir.write("c.obj", "mtllib c.mtl\n" + std::string(square_vertices) + "usemtl a\nf 1 2 3\n"));
+  REQUIRE(c.textures.size() == 1);
+  CHECK(c.textures[0].path == dir.path + "/tex/wood.png");
   CHECK(m.materials[0].name == "Material #1");
   CHECK(m.materials[0].kd.x == 1.0f);
   CHECK(m.materials[1].name == "Material #2");
