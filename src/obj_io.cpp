@@ -202,8 +202,8 @@ static bool unit_normal(vec3f vn, vec3f& out) {
 }
 
 // Index of the texture for (mtl, line, name) in mesh.textures, loading it on first use of its file.
-static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, const std::string& mtl_path, int line,
-                         const char* statement, const std::string& name) {
+static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, folder_cache& folders,
+                         const std::string& mtl_path, int line, const char* statement, const std::string& name) {
   if (name.empty()) return invalid_id;
   const std::string dir = fs::path(mtl_path).parent_path().string();
   const std::string written = resolve_file_name(dir, name);
@@ -214,10 +214,9 @@ static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, co
   if (!fs::exists(path, ec)) {
     // A path from the machine that wrote the MTL (C:\Users\...\wood.png), or a name in another case: the file
     // beside the MTL (a path as it stands), said once per name (later references find it in `loaded`).
-    std::string beside = find_beside(dir, name);
+    std::string beside = find_beside(dir, name, folders);
     if (!beside.empty()) {
-      std::cerr << "warning: " << mtl_path << ":" << line << ": " << statement << ": " << name
-                << " does not exist; using " << beside << "\n";
+      folders.note(mtl_path, line, statement, name, beside);
       path = beside;
     }
   }
@@ -487,10 +486,13 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   std::map<std::string, int> loaded;
   for (const auto& m : clean.materials) {
     material_data md = m.material;
-    md.kd_texture = texture_index(mesh, loaded, m.mtl_path, m.kd_map_line, "map_Kd", m.kd_map);
-    md.alpha_texture = texture_index(mesh, loaded, m.mtl_path, m.alpha_map_line, "map_d", m.alpha_map);
+    md.kd_texture = texture_index(mesh, loaded, clean.folders, m.mtl_path, m.kd_map_line, "map_Kd", m.kd_map);
+    md.alpha_texture = texture_index(mesh, loaded, clean.folders, m.mtl_path, m.alpha_map_line, "map_d", m.alpha_map);
     mesh.materials.push_back(md);
   }
+  if (clean.folders.unsaid > 0)
+    std::cerr << "warning: " << path << ": " << clean.folders.unsaid
+              << " more texture or library names that do not exist were taken from beside the files naming them\n";
   for (int m : mesh.tri_materials)
     if (m == default_material) {
       mesh.materials.push_back(material_data{});

@@ -294,7 +294,18 @@ std::string resolve_file_name(const std::string& dir, const std::string& written
   return path;
 }
 
-std::string find_beside(const std::string& dir, const std::string& written) {
+void folder_cache::note(const std::string& file, int line, const std::string& what, const std::string& name,
+                        const std::string& beside) {
+  if (said >= 3) {
+    unsaid++;
+    return;
+  }
+  said++;
+  std::cerr << "warning: " << file << ":" << line << ": " << what << ": " << name << " does not exist; using " << beside
+            << "\n";
+}
+
+std::string find_beside(const std::string& dir, const std::string& written, folder_cache& cache) {
   std::string name = written;
   if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = name.substr(1, name.size() - 2);
   size_t slash = name.find_last_of("/\\");
@@ -308,15 +319,17 @@ std::string find_beside(const std::string& dir, const std::string& written) {
     for (char& c : x) c = char(std::tolower((unsigned char)c));
     return x;
   };
-  const std::string want = lower(base);
-  std::string found;
-  int matches = 0;
-  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-    std::string entry = it->path().filename().string();
-    if (entry.size() == want.size() && lower(entry) == want && fs::is_regular_file(it->path(), ec))
-      found = it->path().lexically_normal().string(), matches++;
-  }
-  return matches == 1 ? found : std::string();  // (two that differ only in case: neither is more right)
+  auto [listing, fresh] = cache.folders.try_emplace(folder.lexically_normal().string());
+  if (fresh)
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+      std::string entry = it->path().filename().string();
+      listing->second[lower(entry)].push_back(entry);
+    }
+  auto same = listing->second.find(lower(base));
+  if (same == listing->second.end() || same->second.size() != 1) return {};  // (two that differ only in case: neither
+                                                                             // is more right)
+  fs::path found = folder / same->second[0];
+  return fs::is_regular_file(found, ec) ? found.lexically_normal().string() : std::string();
 }
 
 // Number of numeric arguments (min, max) of a texture option, or min = -1 when it takes one word.
@@ -392,7 +405,7 @@ static float scalar_at(const std::vector<string_view>& t, const text_pos& pos) {
 }
 
 // Validates one MTL file, appending its materials (file order) to out.
-static void validate_mtl(const std::string& path, std::vector<mtl_material_data>& out) {
+static void validate_mtl(const std::string& path, std::vector<mtl_material_data>& out, folder_cache& folders) {
   std::string text = read_text_file(path, "material library");
   line_reader lines(text);
   std::vector<string_view> t;
@@ -449,7 +462,8 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
         size_t slash = file.find_last_of("/\\");
         std::string last = slash == std::string::npos ? file : file.substr(slash + 1);
         bool hash_in_last = !name_before_hash_word(last).empty() || (!last.empty() && last[0] == '#');
-        if (fs::is_regular_file(resolve_file_name(dir, cut), ec) || !hash_in_last || find_beside(dir, file).empty())
+        if (fs::is_regular_file(resolve_file_name(dir, cut), ec) || !hash_in_last ||
+            find_beside(dir, file, folders).empty())
           file = cut, xf = cut_xf;
       }
       if (k == "map_Kd") {
@@ -516,6 +530,7 @@ struct obj_pass_state {
   std::vector<size_t> used_lines;          // k -> line of its first usemtl
   std::set<std::string> mtl_files;         // resolved MTL paths already read
   std::vector<mtl_material_data> defined;  // all materials of all MTL files, in load order
+  folder_cache* folders = nullptr;         // the output's listings for find_beside
 };
 
 // Handles an mtllib statement: every named file must exist; each file is read once.
@@ -533,16 +548,15 @@ static void handle_mtllib(const std::vector<string_view>& t, const std::string& 
   for (const auto& name : names) {
     std::string file = resolve_file_name(dir, name);
     if (!fs::exists(file, ec)) {
-      std::string beside = find_beside(dir, name);  // (a path from the machine that wrote the OBJ)
+      std::string beside = find_beside(dir, name, *st.folders);  // (a path from the machine that wrote the OBJ)
       if (!beside.empty()) {
-        std::cerr << "warning: " << pos.file << ":" << pos.line << ": mtllib: " << name << " does not exist; using "
-                  << beside << "\n";
+        st.folders->note(pos.file, int(std::min<size_t>(pos.line, INT_MAX)), "mtllib", name, beside);
         file = beside;
       }
     }
     if (!st.mtl_files.insert(file).second) continue;
     try {
-      validate_mtl(file, st.defined);
+      validate_mtl(file, st.defined, *st.folders);
     } catch (const input_error& e) {
       if (e.line > 0) throw;
       fail(pos, std::string("mtllib: ") + e.what());  // the MTL itself is unreadable: point at this line
@@ -555,6 +569,7 @@ obj_clean_data validate_obj(const std::string& path) {
   std::string dir = fs::path(path).parent_path().string();
   obj_clean_data d;
   obj_pass_state st;
+  st.folders = &d.folders;
   unknown_log unknown;
   std::string body;  // the clean statements after the mtllib line
   body.reserve(text.size());

@@ -223,8 +223,8 @@ texture_data load_texture(const std::string& path) {
   // A PNG's size, from its header: stb_image refuses one of more than 2^30 bytes decoded with "unknown image type"
   // (its other decoders' verdict), which would hide the reason.
   if (bytes.size() >= 24 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0 && bytes.compare(12, 4, "IHDR") == 0) {
-    long long pw = be32(bytes, 16), ph = be32(bytes, 20);
-    if (pw * ph > max_texture_texels)
+    uint64_t pw = be32(bytes, 16), ph = be32(bytes, 20);  // (each below 2^32: the product fits, unsigned)
+    if (pw * ph > uint64_t(max_texture_texels))
       throw input_error(path, "image too large (" + std::to_string(pw) + "x" + std::to_string(ph) + " texels)");
   }
   if (!stbi_info_from_memory(data, len, &w, &h, &n)) throw input_error(path, "cannot decode image: " + stb_reason());

@@ -270,6 +270,10 @@ TEST_CASE("truncated TGA and BMP files and impossible sizes are input errors", "
   std::string ihdr("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x4e\x20\0\0\x4e\x20\x08\x06\0\0\0\0\0\0\0", 33);
   write_bytes(dir.file("huge.png"), ihdr + std::string(64, '\0'));
   CHECK_THAT(texture_error(dir.file("huge.png")), Catch::Contains("huge.png: image too large (20000x20000 texels)"));
+  // The largest sizes a PNG header holds: their product overflowed a signed 64-bit integer (found by fuzzing).
+  std::string max_ihdr("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\xff\xff\xff\xff\xff\xff\xff\xff\x08\x06\0\0\0\0\0\0\0", 33);
+  write_bytes(dir.file("max.png"), max_ihdr + std::string(64, '\0'));
+  CHECK_THAT(texture_error(dir.file("max.png")), Catch::Contains("image too large (4294967295x4294967295 texels)"));
 }
 
 TEST_CASE("an empty texture looks up as black and opaque", "[texture]") {
