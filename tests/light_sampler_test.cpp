@@ -501,20 +501,32 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
   CHECK(checked > 1000);
 }
 
+// Regions of the budget tests: a 16-cell grid, clusters refined into at most 8 members.
+static region_params small_region_params() {
+  region_params rp;
+  rp.grid = 16;
+  rp.max_members = 8;
+  return rp;
+}
+
+// The fine keys, sorted and distinct, of 400 shading points of t (seed 21).
+static std::vector<uint64_t> reached_fine_keys(const test_scene& t, const region_grid_data& grid) {
+  std::vector<uint64_t> keys;
+  for (const shade_point& sp : shading_points(t, 400, 21)) keys.push_back(fine_region_key(grid, sp.p));
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return keys;
+}
+
 TEST_CASE("fine regions over the pair budget are not created, and their keys are not tried again", "[samplers][regions]") {
   // The fine cells that shading points reach, requested at once under a pair budget that holds about half of what
   // they ask for: the regions that fit are created (coarse ones within their own allowance), the others are not, and
   // their keys stay out for good: their pairs are a function of the key and the pair count only grows, so a key
   // once over the budget would only have its cut computed again at every pass, to be turned down again.
   auto t = make_test_scene(false);
-  region_params rp;
-  rp.grid = 16;
-  rp.max_members = 8;
-  std::vector<uint64_t> keys;
+  region_params rp = small_region_params();
   region_state probe = make_region_state(t->scene.bounds, t->tree, false, rp);
-  for (const shade_point& sp : shading_points(*t, 400, 21)) keys.push_back(fine_region_key(probe.grid, sp.p));
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<uint64_t> keys = reached_fine_keys(*t, probe.grid);
   REQUIRE(keys.size() > 20);
   const int64_t base = probe.pairs;  // the root's
   add_regions(probe, t->tree, keys);
@@ -554,14 +566,9 @@ TEST_CASE("coarse regions keep within the pair budget of their own, and the pend
   // the budget at --grid 1024), and every cell a sample touched stayed in the pending table for good (35-40 bytes per
   // NEE sample at --grid 100000).
   auto t = make_test_scene(false);
-  region_params rp;
-  rp.grid = 16;
-  rp.max_members = 8;
-  std::vector<uint64_t> keys;
+  region_params rp = small_region_params();
   region_state probe = make_region_state(t->scene.bounds, t->tree, false, rp);
-  for (const shade_point& sp : shading_points(*t, 400, 21)) keys.push_back(fine_region_key(probe.grid, sp.p));
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<uint64_t> keys = reached_fine_keys(*t, probe.grid);
   const int64_t base = probe.pairs;  // the root's
   add_regions(probe, t->tree, keys);
   int64_t coarse_wanted = 0, coarse_regions = 0;
