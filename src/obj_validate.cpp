@@ -322,6 +322,8 @@ std::string find_beside(const std::string& dir, const std::string& written, fold
   auto [listing, fresh] = cache.folders.try_emplace(folder.lexically_normal().string());
   if (fresh)
     for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+      std::error_code type_ec;
+      if (!it->is_regular_file(type_ec)) continue;  // (files only: a folder of the same name is no rival)
       std::string entry = it->path().filename().string();
       listing->second[lower(entry)].push_back(entry);
     }

@@ -456,6 +456,7 @@ TEST_CASE("files named with another machine's path or in another case are found 
   temp_dir dir;
   write_png(dir, "wood.png");
   write_png(dir, "Leaf.png");
+  std::filesystem::create_directory(dir.path + "/LEAF.png");  // a folder of the same name but for case: no rival
   dir.write("lib2.mtl", "newmtl a\nmap_Kd C:\\Users\\artist\\Documents\\maps\\wood.png\n"
                         "newmtl b\nmap_d leaf.PNG\nmap_Kd /home/someone/wood.png\n");
   auto obj = dir.write("p.obj", "mtllib D:\\work\\lib2.mtl\n" + std::string(square_vertices) +
