@@ -328,6 +328,17 @@ static tinyobj_result parse_clean(const std::string& path, const obj_clean_data&
   return r;
 }
 
+uint64_t corner_set_hash(const std::vector<vec3f>& positions, const int* corners) {
+  uint64_t h = 0;
+  for (int i = 0; i < 3; i++) {
+    vec3f p = positions[size_t(corners[i])] + vec3f{0, 0, 0};  // (-0 as +0)
+    uint32_t b[3];
+    std::memcpy(b, &p, sizeof b);
+    h += mix64((uint64_t(b[0]) << 32 | b[1]) ^ mix64(b[2]));  // a sum: independent of the corners' order
+  }
+  return h;
+}
+
 corner_key triangle_corner_key(const std::vector<vec3f>& positions, const int* corners, bool reversed) {
   std::array<std::array<uint32_t, 3>, 3> c{};
   for (int i = 0; i < 3; i++) {
@@ -359,16 +370,7 @@ static std::pair<int, int> drop_repeated_triangles(mesh_data& mesh, const std::v
   auto has_cutout = [&](size_t t) { return cutout[size_t(mesh.tri_materials[t])] != 0; };
   // Grouped by a hash of the corner set (cheap; exact keys are compared within a group only).
   std::vector<std::pair<uint64_t, uint32_t>> groups(n);
-  for (size_t t = 0; t < n; t++) {
-    uint64_t h = 0;
-    for (int i = 0; i < 3; i++) {
-      vec3f p = pos[size_t(mesh.tri_positions[3 * t + size_t(i)])] + vec3f{0, 0, 0};  // (-0 as +0)
-      uint32_t b[3];
-      std::memcpy(b, &p, sizeof b);
-      h += mix64((uint64_t(b[0]) << 32 | b[1]) ^ mix64(b[2]));
-    }
-    groups[t] = {h, uint32_t(t)};
-  }
+  for (size_t t = 0; t < n; t++) groups[t] = {corner_set_hash(pos, &mesh.tri_positions[3 * t]), uint32_t(t)};
   std::sort(groups.begin(), groups.end());
   std::vector<char> drop(n, 0);
   std::vector<std::pair<corner_key, uint32_t>> keys;

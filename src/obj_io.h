@@ -56,6 +56,9 @@ inline int triangle_count(const mesh_data& m) { return int(m.tri_materials.size(
 // (the same side in front). `reversed`: the key of its other side (corners 0, 2, 1).
 using corner_key = std::array<uint32_t, 9>;
 corner_key triangle_corner_key(const std::vector<vec3f>& positions, const int* corners, bool reversed = false);
+// A hash of a triangle's corner set, whatever their order (-0 as +0): triangles with the same corners in any order
+// share it, so grouping by it finds repeats and reverses without comparing every pair.
+uint64_t corner_set_hash(const std::vector<vec3f>& positions, const int* corners);
 
 // Loads an OBJ file with its MTL libraries (relative to the OBJ's folder) and the map_Kd / map_d textures of
 // the materials it uses (relative to their MTL's folder). Unrecognised statements are reported on stderr.

@@ -134,10 +134,12 @@ static std::string join_from(const std::vector<string_view>& t, size_t first) {
 
 // True when t follows tinyobjloader's number grammar in full: [sign] (digits [. digits] | . digits)
 // [(e|E) [sign] digits]; exponent_too_big when the decimal exponent is above 300 (a negative one of any size is
-// fine: the value rounds to a denormal or 0 in our strtof and in tinyobjloader's ldexp alike).
-static bool number_grammar(string_view t, bool& exponent_too_big) {
+// fine: the value rounds to a denormal or 0 in our strtof and in tinyobjloader's ldexp alike); exponent_below_300
+// (when given) when it is below -300.
+static bool number_grammar(string_view t, bool& exponent_too_big, bool* exponent_below_300 = nullptr) {
   size_t i = 0, n = t.size();
   exponent_too_big = false;
+  if (exponent_below_300) *exponent_below_300 = false;
   if (i < n && (t[i] == '+' || t[i] == '-')) i++;
   size_t digits = 0;
   while (i < n && t[i] >= '0' && t[i] <= '9') i++, digits++;
@@ -158,18 +160,15 @@ static bool number_grammar(string_view t, bool& exponent_too_big) {
     }
     if (exp_digits == 0) return false;
     exponent_too_big = !negative && exponent > 300;
+    if (exponent_below_300) *exponent_below_300 = negative && exponent > 300;
   }
   return i == n;
 }
 
 // Whether number t (number_grammar's) has a decimal exponent below -300.
 static bool exponent_below_300(string_view t) {
-  size_t e = t.find_first_of("eE");
-  if (e == string_view::npos || e + 1 >= t.size() || t[e + 1] != '-') return false;
-  long exponent = 0;
-  for (size_t i = e + 2; i < t.size() && t[i] >= '0' && t[i] <= '9'; i++)
-    exponent = std::min(exponent * 10 + (t[i] - '0'), 100000L);
-  return exponent > 300;
+  bool too_big = false, below = false;
+  return number_grammar(t, too_big, &below) && below;
 }
 
 // Parses t as a number (see number_grammar) into out; false (with a reason) when it is not one.

@@ -2,12 +2,10 @@
 #include "scene.h"
 
 #include "errors.h"
-#include "rng.h"
 #include "texture.h"
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 
 namespace bl {
 
@@ -41,16 +39,7 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
   // Reversed twins: of the triangles with the same three corners (grouped by a hash of the corner set, independent
   // of their order), the lowest-numbered one whose key is this one's reversed key.
   std::vector<std::pair<uint64_t, int>> groups(static_cast<size_t>(n));
-  for (int t = 0; t < n; t++) {
-    uint64_t h = 0;
-    for (int i = 0; i < 3; i++) {
-      vec3f p = m.positions[size_t(m.tri_positions[3 * size_t(t) + size_t(i)])] + vec3f{0, 0, 0};  // (-0 as +0)
-      uint32_t b[3];
-      std::memcpy(b, &p, sizeof b);
-      h += mix64((uint64_t(b[0]) << 32 | b[1]) ^ mix64(b[2]));
-    }
-    groups[size_t(t)] = {h, t};
-  }
+  for (int t = 0; t < n; t++) groups[size_t(t)] = {corner_set_hash(m.positions, &m.tri_positions[3 * size_t(t)]), t};
   std::sort(groups.begin(), groups.end());
   std::vector<std::pair<corner_key, int>> keys;
   for (size_t g = 0, e; g < groups.size(); g = e) {
