@@ -121,7 +121,11 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
   double hz = tsc_hz();
   const path_stats& st = a.stats;
   double nee = double(std::max<uint64_t>(st.nee_samples, 1));
-  double nee_b = double(std::max<uint64_t>(b.stats.nee_samples, 1));
+  // Without a single NEE sample (no emitters, or none that any shaded point can sample) the stages are per camera
+  // ray instead: per NEE sample they would be divided by a count of 0.
+  const bool per_ray = b.stats.nee_samples == 0;
+  double nee_b = double(std::max<uint64_t>(per_ray ? b.stats.camera_rays : b.stats.nee_samples, 1));
+  const char* unit = per_ray ? "camera ray" : "NEE sample";
   ray_set rays = make_shadow_rays(scene, bvh, lights, params.width, params.height,
                                   std::min<size_t>(std::max<uint64_t>(st.shadow_rays, 1), size_t(4) << 20));
   double limit = occlusion_rate(bvh, rays, threads);
@@ -139,12 +143,13 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
        "%.2f M, bounce %.2f M)\n",
        a.seconds, a.passes, nee * 1e-6, nee / a.seconds * 1e-6, rays_total / a.seconds * 1e-6,
        double(st.camera_rays) * 1e-6, double(st.shadow_rays) * 1e-6, double(st.bounce_rays) * 1e-6);
-  line("  timed render: the same %d spp, %.3f s; stages below per NEE sample of it\n", b.spp, b.seconds);
+  line("  timed render: the same %d spp, %.3f s; stages below per %s of it%s\n", b.spp, b.seconds, unit,
+       per_ray ? " (the render took no NEE sample)" : "");
   // Stage times are per-thread cycles; in wall time per NEE sample they are divided by the thread count.
   double pass_wall = b.seconds - b.learn_seconds;
   double staged = 0;
   for (int c = 0; c < prof_count; c++) staged += double(b.profile_cycles[c]) / hz / threads;
-  line("\n  %-44s %10s %8s\n", "stage (timed render)", "ns/NEE", "share");
+  line("\n  %-44s %10s %8s\n", "stage (timed render)", per_ray ? "ns/ray" : "ns/NEE", "share");
   for (int c = 0; c < prof_count; c++) {
     double wall = double(b.profile_cycles[c]) / hz / threads;
     line("  %-44s %10.1f %7.1f%%\n", stage_name(c), wall / nee_b * 1e9, 100 * wall / b.seconds);
@@ -161,8 +166,8 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
          100 * lp.regions / b.seconds);
     line("  %-44s %10.1f %7.1f%%\n", "  of which: refold of changed weights", lp.refold / nee_b * 1e9,
          100 * lp.refold / b.seconds);
-    line("  %-44s %10.2f records, %.2f refolds per NEE sample (%.1f, %.1f ns each)\n", "  learning work:",
-         lp.records / nee_b, lp.refolds / nee_b, lp.reduce / std::max(lp.records, 1.0) * 1e9,
+    line("  %-44s %10.2f records, %.2f refolds per %s (%.1f, %.1f ns each)\n", "  learning work:",
+         lp.records / nee_b, lp.refolds / nee_b, unit, lp.reduce / std::max(lp.records, 1.0) * 1e9,
          lp.refold / std::max(lp.refolds, 1.0) * 1e9);
   }
   line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee_b * 1e9, 100.0);

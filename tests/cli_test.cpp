@@ -675,6 +675,18 @@ TEST_CASE("profile with --time times the same samples twice and reports their st
   CHECK(r.output.find("nan") == std::string::npos);
 }
 
+TEST_CASE("a profile of a scene without NEE samples gives its stages per camera ray", "[cli]") {
+  // With no emitter every stage was divided by a NEE count of 0 (taken as 1) and printed as ns per NEE sample.
+  temp_dir dir;
+  write_text(dir / "dark.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  auto r = run_bayeslight("profile " + dir / "dark.obj" + " --width 8 --height 8 --spp 2 --threads 1");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("stages below per camera ray of it (the render took no NEE sample)") != std::string::npos);
+  CHECK(r.output.find("ns/ray") != std::string::npos);
+  CHECK(r.output.find("ns/NEE") == std::string::npos);
+}
+
 TEST_CASE("an interrupted profile says so and prints no report", "[cli]") {
   // It printed a table of -nan % and ran the shadow-ray benchmark before exiting 130 (a review).
   std::string cmd = "timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " profile " +
