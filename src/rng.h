@@ -1,6 +1,7 @@
 // rng: every random number of a render, keyed by (seed, pixel, sample, path vertex, dimension).
 // Invariants: a (pixel, sample) pair owns one PCG32 key; each path vertex draws its own fixed-size block of
-// uniforms from the PCG32 stream numbered by the vertex, in the fixed order of the dimension table below.
+// uniforms from a PCG32 generator seeded by a hash of (key, vertex) (vertex_seed), in the fixed order of the
+// dimension table below.
 // So changing the light sampler (which uses only the light dimensions) leaves camera rays and BSDF samples
 // untouched, and no random number depends on thread identity or timing. The camera's jitter and, at the first
 // vertex, the light choice, light point and BSDF direction come instead from randomised Sobol' sets over a pixel's
@@ -60,10 +61,19 @@ inline uint64_t sample_key(uint64_t seed, uint64_t pixel, uint64_t sample) {
 // Uniform float in [0, 1) from the top 24 bits of a 32-bit draw (exactly representable).
 inline float uint_to_unit(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
 
+// The PCG32 state seed of path vertex `vertex` of the sample with key `key`. Every vertex has its own hashed seed on
+// one stream: PCG32 generators that share a seed and differ only in their stream (increment) run through states
+// that differ by a key-independent offset at every step, and their outputs are correlated. With the vertex as the
+// stream (before 2026-12), Russian roulette with survival 0.9 let a path pass vertices 3..30 with frequency 0.039
+// instead of 0.052, and a furnace of albedo 0.9 at depth 50 rendered 9.60 instead of 9.95.
+inline uint64_t vertex_seed(uint64_t key, uint32_t vertex) {
+  return mix64(key ^ (uint64_t(vertex) * 0xd1b54a32d192ed03ull));
+}
+
 // The block of uniforms of path vertex `vertex` (1 = the first hit; the camera's jitter is pixel_jitter's) of the
 // sample with key `key`.
 inline vertex_randoms draw_vertex(uint64_t key, uint32_t vertex) {
-  pcg32 rng(key, vertex);
+  pcg32 rng(vertex_seed(key, vertex), 0);
   vertex_randoms r;
   for (int i = 0; i < dims_per_vertex; i++) {
     r.raw[i] = rng();
