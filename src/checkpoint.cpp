@@ -17,7 +17,8 @@ namespace {
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
 // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos; 5: mean hierarchy (k_folded);
 // 6: bayes fallback check; 7: no point-prior weights in region-prior mode; 8: the stratified set's first sample;
-// 9: members; 10: reversed twin faces (a ray meets the one turned toward it); 11: hashed per-vertex PCG32 seeds
+// 9: members; 10: reversed twin faces (a ray meets the one turned toward it); 11: hashed per-vertex PCG32 seeds, the
+// reference's hash
 constexpr uint32_t version = 11;
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
@@ -324,20 +325,30 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(scene.sun.enabled), h.vec(scene.sun.direction), h.vec(scene.sun.irradiance);
   h.value(scene.sun.angular_diameter_deg), h.value(scene.two_sided_emitters);
   h.value(p.width), h.value(p.height), h.value(p.max_depth), h.value(p.seed), h.value(int(p.sampler.kind));
-  h.value(p.pass_weighting);
   h.value(p.stratify);
-  const region_params& r = p.sampler.regions;
-  h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
-  h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
-  h.value(r.max_members);
-  const bayes_params& b = p.sampler.bayes;
-  h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
-  h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
-  h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
-  h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
-  h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
-  const donikian_params& d = p.sampler.donikian;
-  h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
+  // Only the options of the sampler in use: a uniform render resumed with another --grid or --bayes-b0 (which
+  // cannot change its image) was refused as a different render.
+  const sampler_kind k = p.sampler.kind;
+  const bool regions = k == sampler_kind::bound || k == sampler_kind::donikian || k == sampler_kind::bayes;
+  if (k == sampler_kind::donikian || k == sampler_kind::bayes) h.value(p.pass_weighting);  // the adaptive ones
+  if (regions) {
+    const region_params& r = p.sampler.regions;
+    h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
+    h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
+    h.value(r.max_members);
+  }
+  if (k == sampler_kind::bayes) {
+    const bayes_params& b = p.sampler.bayes;
+    h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
+    h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
+    h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
+    h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
+    h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
+  }
+  if (k == sampler_kind::donikian) {
+    const donikian_params& d = p.sampler.donikian;
+    h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
+  }
   return h.h;
 }
 
@@ -347,11 +358,21 @@ uint64_t checkpoint_checksum(std::string_view body) {
   return h.h;
 }
 
-std::string encode_checkpoint(uint64_t fingerprint, const render_result& result, const light_sampler& sampler) {
+uint64_t reference_hash(const image_data* reference) {
+  if (!reference) return 0;
+  hasher h;
+  h.value(reference->width), h.value(reference->height);
+  h.bytes(reference->pixels.data(), reference->pixels.size() * sizeof(float));
+  return h.h == 0 ? 1 : h.h;
+}
+
+std::string encode_checkpoint(uint64_t fingerprint, uint64_t reference, const render_result& result,
+                              const light_sampler& sampler) {
   writer w;
   w.out.append(magic, sizeof magic);
   w.value(version);
   w.value(fingerprint);
+  w.value(reference);
   w.value(uint32_t(sampler.index()));
   w.value(result.width), w.value(result.height), w.value(result.passes), w.value(result.spp), w.value(result.stratum_base);
   w.value(result.seconds);
@@ -368,8 +389,8 @@ std::string encode_checkpoint(uint64_t fingerprint, const render_result& result,
   return w.out;
 }
 
-void decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint, double pass_weighting,
-                       render_result& result, light_sampler& sampler) {
+uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
+                           double pass_weighting, render_result& result, light_sampler& sampler) {
   if (bytes.size() < sizeof magic + 8 || std::memcmp(bytes.data(), magic, sizeof magic) != 0)
     throw input_error(path, "not a bayeslight checkpoint");
   uint64_t stored;
@@ -380,6 +401,7 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
   if (r.value<uint32_t>() != version) throw input_error(path, "checkpoint of another bayeslight version");
   if (r.value<uint64_t>() != fingerprint)
     throw input_error(path, "checkpoint was written for a different scene or different render options");
+  const uint64_t reference = r.value<uint64_t>();
   if (r.value<uint32_t>() != uint32_t(sampler.index())) r.fail("sampler kind");
   int w = r.value<int>(), hgt = r.value<int>();
   if (w != result.width || hgt != result.height) r.fail("image size");
@@ -432,6 +454,7 @@ void decode_checkpoint(const std::string& bytes, const std::string& path, uint64
   if (auto* b = std::get_if<bayes_sampler>(&sampler); b && !b->px_var.empty() && b->px_var.size() != result.film.size() / 3)
     r.fail("fallback check");  // its columns are indexed by pixel
   if (r.pos != body.size()) r.fail("trailing data");
+  return reference;
 }
 
 }  // namespace bl

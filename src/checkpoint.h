@@ -23,12 +23,19 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& params
 // The checksum a checkpoint ends with, of everything before it (a guard against accidental damage, not a seal).
 uint64_t checkpoint_checksum(std::string_view body);
 
-// Serialises a completed-pass state: the result so far and the sampler's learned state.
-std::string encode_checkpoint(uint64_t fingerprint, const render_result& result, const light_sampler& sampler);
+// Hash of a reference image's size and pixels (0: no reference): which reference a checkpoint's logged errors
+// were measured against. Not part of the fingerprint (the reference does not change the image).
+uint64_t reference_hash(const image_data* reference);
+
+// Serialises a completed-pass state: the result so far, the sampler's learned state and the hash of the reference
+// the log's errors were measured against.
+std::string encode_checkpoint(uint64_t fingerprint, uint64_t reference, const render_result& result,
+                              const light_sampler& sampler);
 // Restores a state written by encode_checkpoint into a freshly built sampler of the same kind and the result;
 // throws input_error naming `path` when the data are malformed or were written for another scene/options.
 // `pass_weighting`: the render's (render_params::pass_weighting), against which the film's weight is checked.
-void decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint, double pass_weighting,
-                       render_result& result, light_sampler& sampler);
+// Returns the stored reference hash.
+uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
+                           double pass_weighting, render_result& result, light_sampler& sampler);
 
 }  // namespace bl

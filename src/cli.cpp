@@ -65,7 +65,7 @@ struct render_options {
   std::string checkpoint;
   double checkpoint_every = 30;
   std::string resume;
-  int stop_after_passes = 0;  // testing aid: raise SIGINT after this many passes
+  int stop_after_passes = -1;  // testing aid: raise SIGINT after this many passes (0: while the render sets up)
   int kill_after_passes = 0;  // testing aid: raise SIGKILL right after the checkpoint of this pass
 };
 
@@ -257,9 +257,24 @@ int run_render(const render_options& o) {
   }
 
   uint64_t fingerprint = render_fingerprint(scene, params);
+  const uint64_t reference_key = reference_hash(references.empty() ? nullptr : &references[0]);
+  if (o.stop_after_passes == 0)  // (the render's set-up calls restore)
+    params.restore = [](render_result&, light_sampler&) { std::raise(SIGINT); };
   if (!o.resume.empty())
-    params.restore = [&](render_result& r, light_sampler& s) {
-      decode_checkpoint(resume_bytes, o.resume, fingerprint, params.pass_weighting, r, s);
+    params.restore = [&, setup_signal = o.stop_after_passes == 0](render_result& r, light_sampler& s) {
+      if (setup_signal) std::raise(SIGINT);
+      uint64_t measured = decode_checkpoint(resume_bytes, o.resume, fingerprint, params.pass_weighting, r, s);
+      // The log is one error curve against one reference: rows measured against another one (or none) keep their
+      // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
+      if (measured != reference_key && !r.log.empty()) {
+        for (pass_record& p : r.log) p.has_error = false;
+        std::fprintf(stderr,
+                     "%s: warning: its %d passes were %s; their rows of the log have no error values\n",
+                     o.resume.c_str(), r.passes,
+                     measured == 0        ? "rendered without --reference"
+                     : reference_key == 0 ? "measured against a reference, and this render has none"
+                                          : "measured against another reference");
+      }
       // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
       if (params.time_budget <= 0 && r.spp > params.spp)
         throw usage_error((o.spp > 0 ? "--spp " + std::to_string(params.spp)
@@ -273,12 +288,13 @@ int run_render(const render_options& o) {
   std::string checkpoint_failure;
   params.on_pass = [&](const render_result& r, const light_sampler& s, bool last) {
     if (!last && o.stop_after_passes > 0 && r.passes == o.stop_after_passes) std::raise(SIGINT);
-    if (o.checkpoint.empty()) return;
+    // A render stopped before its first pass has nothing to save: a checkpoint already there is kept.
+    if (o.checkpoint.empty() || r.passes == 0) return;
     auto now = std::chrono::steady_clock::now();
     bool due = std::chrono::duration<double>(now - last_write).count() >= o.checkpoint_every;
     if (!last && !due && r.passes != o.kill_after_passes) return;
     try {
-      write_file_atomic(o.checkpoint, encode_checkpoint(fingerprint, r, s));
+      write_file_atomic(o.checkpoint, encode_checkpoint(fingerprint, reference_key, r, s));
     } catch (const output_error& e) {
       if (checkpoint_failure.empty())
         std::fprintf(stderr, "bayeslight: warning: %s; the render goes on without it\n", e.what());
@@ -297,7 +313,9 @@ int run_render(const render_options& o) {
       image_data img = film_image(result);
       for (const std::string& f : files) write_image(f, img);
     }
-    if (!o.log.empty()) write_file_atomic(frame_path(o.log, frame, animated), pass_log_csv(o.sampler, result.log));
+    // (Nor a log without a pass: a file already there is kept, as the image is.)
+    if (!o.log.empty() && result.passes > 0)
+      write_file_atomic(frame_path(o.log, frame, animated), pass_log_csv(o.sampler, result.log));
     if (!o.quiet || result.interrupted) {
       std::string prefix = params.frames > 1 ? "frame " + std::to_string(frame) + ": " : "";
       std::fprintf(stderr, "%s%s\n", prefix.c_str(), render_summary(result, files).c_str());
@@ -488,7 +506,7 @@ void add_render_command(CLI::App& app, render_options& o) {
                 "Continue the render saved in FILE (same scene and options; --spp may be larger: the same bytes as one render "
                 "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...)")
       ->check(file_name);
-  r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes")
+  r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes (0: during set-up)")
       ->group("");
   r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")
       ->group("");

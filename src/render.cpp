@@ -14,6 +14,7 @@
 #include <csignal>
 #include <pthread.h>
 #include <thread>
+#include <memory>
 #include <type_traits>
 #include <unistd.h>
 
@@ -22,12 +23,15 @@ namespace bl {
 namespace {
 
 std::atomic<int> g_signal{0};
-// From install_interrupt_handlers until interrupted_before_render: loading the scene and setting up, when nothing has
-// been written yet, and a loader deep in a large file would notice a request only once it is done.
-std::atomic<bool> g_setup{false};
+// Where the command stands, for a signal: while setting up (loading the scene; then, in the first render_frames, the
+// light tree, the sampler's regions and a checkpoint's state) nothing has been written yet, and a loader deep in a
+// large file would notice a request only once it is done, so the handler ends the process at once; afterwards it
+// asks the render to stop after its pass.
+enum phase : int { phase_none = 0, phase_setup = 1, phase_before_render = 2, phase_render = 3 };
+std::atomic<int> g_phase{phase_none};
 
 extern "C" void on_interrupt(int sig) {
-  if (g_setup.load()) {
+  if (g_phase.load() == phase_setup) {
     // Async-signal-safe: write(2) and _exit(2) only.
     static const char term[] = "bayeslight: interrupted (SIGTERM) while loading the scene; nothing written\n";
     static const char intr[] = "bayeslight: interrupted (SIGINT) while loading the scene; nothing written\n";
@@ -311,6 +315,22 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   in.stratify = params.stratify;
   int frames = std::max(1, params.frames);
   auto t0 = clock_type::now();
+  // The first render of a command that installed the handlers sets up as the loader does: a signal ends it at once
+  // (before, the signal waited for the light tree and regions, seconds in a large scene, and the render that
+  // followed stopped before its first pass and wrote an empty checkpoint over the one given). Later renders of the
+  // same command (compare's next sampler, profile's timed render) keep what the earlier ones wrote: they stop after
+  // their pass.
+  struct setup_scope {
+    bool active = false;
+    setup_scope() {
+      int expected = phase_before_render;
+      active = g_signal.load() == 0 && g_phase.compare_exchange_strong(expected, phase_setup);
+    }
+    ~setup_scope() {
+      if (active) g_phase.store(phase_render);
+    }
+  };
+  auto in_setup = std::make_unique<setup_scope>();
   light_tree_data tree;
   if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
   light_sampler sampler = make_light_sampler(params.sampler, in, tree);
@@ -318,6 +338,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   restored.width = params.width;
   restored.height = params.height;
   if (params.restore) params.restore(restored, sampler);
+  in_setup.reset();
   bool resuming = !restored.film.empty();
   // (A resumed render's model was frozen by its oracle unless the oracle itself was interrupted: see below.)
   if (auto* b = std::get_if<bayes_sampler>(&sampler); b && params.sampler.bayes.oracle_spp > 0 && !b->frozen) {
@@ -384,7 +405,7 @@ image_data film_image(const render_result& r) {
 }
 
 void install_interrupt_handlers() {
-  g_setup.store(true);
+  g_phase.store(phase_setup);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
   // A process started with them blocked (a launcher's mask is inherited) could not be interrupted at all; one that
@@ -398,7 +419,7 @@ void install_interrupt_handlers() {
 int interrupt_signal() { return g_signal.load(); }
 void reset_interrupt() { g_signal.store(0); }
 int interrupted_before_render() {
-  g_setup.store(false);  // from here a signal asks the render to stop after its pass
+  g_phase.store(phase_before_render);  // until the first render sets up, a signal asks it to stop after its pass
   int sig = g_signal.load();
   if (sig == 0) return 0;
   std::fprintf(stderr, "bayeslight: interrupted (%s) while loading the scene; nothing written\n",
