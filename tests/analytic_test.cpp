@@ -270,37 +270,12 @@ TEST_CASE("a wall thinner than the default ray offset still shadows a point besi
     }
 }
 
-TEST_CASE("a furnace sphere of emitting grey walls sums its bounces", "[analytic]") {
-  // Closed surface, every triangle emits Le (two-sided) with albedo rho: radiance Le * sum_{k=0..D} rho^k.
-  // A tessellated sphere, not a box: in a box, the NEE of a vertex near an edge samples the adjacent wall with an
-  // integrand ~ 1/d^2, and over vertices near edges its variance is infinite (value tail ~ y^-3/2), so a
-  // standard error measured from pixels says nothing and the z test below would pass or fail by luck. Between
-  // the sphere's faces (about 6 degrees apart) the same term carries a factor sin^2 of that angle.
-  const float le = 1.0f, rho = 0.5f;
-  for (sampler_kind kind : kinds)
-    for (int depth : {1, 3, 5}) {
-      mesh_builder b;
-      int wall = b.add_material({rho, rho, rho}, {le, le, le});
-      b.add_sphere({0, 0, 0}, 1, 32, wall);
-      camera_params cam;
-      cam.automatic = false;
-      cam.eye = {0, 0, 0};
-      cam.target = {0, 0, 1};
-      cam.fov_y_deg = 12;
-      double exact = 0;
-      for (int k = 0; k <= depth; k++) exact += le * std::pow(rho, k);
-      INFO("sampler " << sampler_name(kind) << " depth " << depth);
-      check_estimate(render_pixels(b.mesh, cam, {}, true, kind, depth, 512), exact);
-    }
-}
-
-TEST_CASE("a furnace of albedo 0.9 sums fifty bounces", "[analytic]") {
-  // Deep paths: Russian roulette draws at every vertex from the third. Correlated draws between vertices (each
-  // vertex's PCG32 stream number on one shared seed, before 2026-12) rendered 9.60 for the exact 9.954 (-17 sigma).
-  const float le = 1.0f, rho = 0.9f;
-  const int depth = 50;
+namespace {
+// A closed sphere of 32 x 32 faces, each emitting Le = 1 (two-sided) with albedo rho, seen from its centre: the
+// radiance is sum_{k=0..depth} rho^k (see the test below for why a sphere).
+void check_furnace(float rho, sampler_kind kind, int depth, int spp, int size) {
   mesh_builder b;
-  int wall = b.add_material({rho, rho, rho}, {le, le, le});
+  int wall = b.add_material({rho, rho, rho}, {1, 1, 1});
   b.add_sphere({0, 0, 0}, 1, 32, wall);
   camera_params cam;
   cam.automatic = false;
@@ -308,8 +283,28 @@ TEST_CASE("a furnace of albedo 0.9 sums fifty bounces", "[analytic]") {
   cam.target = {0, 0, 1};
   cam.fov_y_deg = 12;
   double exact = 0;
-  for (int k = 0; k <= depth; k++) exact += le * std::pow(rho, k);
-  check_estimate(render_pixels(b.mesh, cam, {}, true, sampler_kind::uniform, depth, 512, 16), exact);
+  for (int k = 0; k <= depth; k++) exact += std::pow(rho, k);
+  check_estimate(render_pixels(b.mesh, cam, {}, true, kind, depth, spp, size), exact);
+}
+}  // namespace
+
+TEST_CASE("a furnace sphere of emitting grey walls sums its bounces", "[analytic]") {
+  // Closed surface, every triangle emits Le (two-sided) with albedo rho: radiance Le * sum_{k=0..D} rho^k.
+  // A tessellated sphere, not a box: in a box, the NEE of a vertex near an edge samples the adjacent wall with an
+  // integrand ~ 1/d^2, and over vertices near edges its variance is infinite (value tail ~ y^-3/2), so a
+  // standard error measured from pixels says nothing and the z test below would pass or fail by luck. Between
+  // the sphere's faces (about 6 degrees apart) the same term carries a factor sin^2 of that angle.
+  for (sampler_kind kind : kinds)
+    for (int depth : {1, 3, 5}) {
+      INFO("sampler " << sampler_name(kind) << " depth " << depth);
+      check_furnace(0.5f, kind, depth, 512, 8);
+    }
+}
+
+TEST_CASE("a furnace of albedo 0.9 sums fifty bounces", "[analytic]") {
+  // Deep paths: Russian roulette draws at every vertex from the third. Correlated draws between vertices (each
+  // vertex's PCG32 stream number on one shared seed, before 2026-12) rendered 9.60 for the exact 9.954 (-17 sigma).
+  check_furnace(0.9f, sampler_kind::uniform, 50, 512, 16);
 }
 
 TEST_CASE("the sun lights a floor with its irradiance times the cosine", "[analytic]") {
