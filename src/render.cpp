@@ -14,7 +14,7 @@
 #include <csignal>
 #include <pthread.h>
 #include <thread>
-#include <memory>
+#include <optional>
 #include <type_traits>
 #include <unistd.h>
 
@@ -330,7 +330,8 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
       if (active) g_phase.store(phase_render);
     }
   };
-  auto in_setup = std::make_unique<setup_scope>();
+  std::optional<setup_scope> in_setup;
+  in_setup.emplace();
   light_tree_data tree;
   if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
   light_sampler sampler = make_light_sampler(params.sampler, in, tree);
