@@ -374,7 +374,12 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     }
     std::function<void()> after_pass;
     if (params.on_pass) after_pass = [&] { params.on_pass(result, sampler, false); };
-    std::visit([&](auto& s) { render_with(in, s, fp, result, after_pass); }, sampler);
+    // Each frame has its own random streams (frame 0 the render's seed): with the same streams in every frame, a
+    // learning sampler began frame k with statistics learned from the very samples it was about to draw again, so
+    // its light choices depended on their own outcomes (bayes 1 % dark from frame 1 on with a still sun, z -22).
+    render_inputs frame_in = in;
+    frame_in.seed = frame_seed(params.seed, frame);
+    std::visit([&](auto& s) { render_with(frame_in, s, fp, result, after_pass); }, sampler);
     if (params.on_pass) params.on_pass(result, sampler, true);
     result.sampler_bytes = sampler_memory_bytes(sampler);
     if (auto* b = std::get_if<bound_sampler>(&sampler)) result.regions = int(b->regions.key.size()), result.pairs = b->regions.pairs;

@@ -50,6 +50,12 @@ inline uint64_t mix64(uint64_t z) {
   return z ^ (z >> 31);
 }
 
+// The seed of frame `frame` of an animation rendered with seed `seed` (frame 0: the seed itself, so a one-frame
+// render is the still render): every frame draws its own streams.
+inline uint64_t frame_seed(uint64_t seed, int frame) {
+  return frame == 0 ? seed : mix64(seed ^ (uint64_t(frame) * 0xa0761d6478bd642full));
+}
+
 // The PCG32 key of sample `sample` of pixel `pixel` under render seed `seed`.
 // (Its per-pixel part, pixel_key_base, is what pixel_streams caches.)
 inline uint64_t pixel_key_base(uint64_t seed, uint64_t pixel) { return mix64(mix64(seed) ^ pixel); }
