@@ -17,9 +17,9 @@ namespace {
 constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-', 'C', 'K', 'P', 'T', 0};
 // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos; 5: mean hierarchy (k_folded);
 // 6: bayes fallback check; 7: no point-prior weights in region-prior mode; 8: the stratified set's first sample;
-// 9: members; 10: reversed twin faces (a ray meets the one turned toward it); 11: hashed per-vertex PCG32 seeds, the
+// 9: members; 10: reversed twin faces (a ray meets the one turned toward it); 11: hashed per-vertex PCG32 seeds; 12: the
 // reference's hash
-constexpr uint32_t version = 11;
+constexpr uint32_t version = 12;
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {

@@ -261,7 +261,14 @@ static constexpr const char* summary_file = "summary.md";
 
 void write_comparison(const compare_data& data, const compare_params& p, const image_data& reference) {
   for (const compare_sampler& s : data.samplers) {
-    if (s.image.pixels.empty()) continue;
+    if (s.image.pixels.empty()) {
+      // Interrupted before this sampler's first pass: images an earlier comparison left here would sit beside a
+      // summary that lists none for it.
+      std::error_code ec;
+      fs::remove(image_file(p, s.kind), ec);
+      fs::remove(error_file(p, s.kind), ec);
+      continue;
+    }
     write_image(image_file(p, s.kind), s.image);
     write_error_image(error_file(p, s.kind), s.image, reference, p.error_image);
   }
@@ -311,6 +318,14 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
 
   if (int status = interrupted_before_render()) return status;
   compare_data data = run_comparison(scene, bvh, lights, reference, params);
+  bool any_pass = false;
+  for (const compare_sampler& s : data.samplers)
+    for (const compare_run& r : s.runs) any_pass = any_pass || !r.log.empty();
+  if (!any_pass && data.signal != 0) {
+    // Nothing to report (as render, which then keeps the files already there).
+    std::fprintf(stderr, "compare: interrupted before the first pass; nothing written\n");
+    return 128 + data.signal;
+  }
   write_comparison(data, params, reference);
   if (!params.quiet || data.signal != 0)
     std::fprintf(stderr, "compare: %s -> %s (summary.md, curves.csv, error_vs_time.svg, <sampler>.exr, "

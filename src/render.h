@@ -92,8 +92,9 @@ render_result render(const scene_data& scene, const bvh_data& bvh, const light_d
                      const render_params& params);
 // Renders params.frames frames of an animation in which the sun moves along the great circle from
 // sun.direction to sun.direction_end; the light sampler (and what it learned) carries over from frame to
-// frame, its statistics scaled by params.frame_decay at each frame start. Every frame uses the same seed and
-// pass schedule, so frame k of a non-learning sampler equals a single render with that frame's sun. Calls
+// frame, its statistics scaled by params.frame_decay at each frame start. Frame k draws the streams of
+// frame_seed(seed, k) with the same pass schedule, so frame k of a non-learning sampler equals a single render
+// with that frame's sun and that seed (a learning sampler must not draw again the samples it learned from). Calls
 // on_frame(k, result) after each frame; stops after an interrupted frame (its result says so).
 void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lights, const render_params& params,
                    const std::function<void(int, const render_result&)>& on_frame);

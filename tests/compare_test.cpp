@@ -316,6 +316,48 @@ TEST_CASE("compare at equal spp writes curves summary plot and images", "[compar
     CHECK(e.path().filename().string().find(".tmp") == std::string::npos);
 }
 
+TEST_CASE("compare interrupted before any pass keeps an earlier comparison's files", "[compare]") {
+  // It rewrote curves.csv (header only), summary.md and the plot over the earlier results (a review). A signal 1 s
+  // in reaches bayes's oracle warm-up (far longer than 1 s; set-up takes milliseconds): no pass is complete.
+  compare_scene s;
+  std::string out = s.dir / "out";
+  std::string args = "compare " + s.json + " --reference " + s.ref + " --samplers bayes,uniform --out " + out +
+                     " --threads 1 --quiet";
+  REQUIRE(run_bayeslight(args + " --spp 2").status == 0);
+  std::map<std::string, std::string> before;
+  for (auto& e : std::filesystem::directory_iterator(out)) before[e.path().string()] = slurp(e.path().string());
+  REQUIRE(before.size() >= 5);
+  run_result r;
+  FILE* p = popen(("timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " " + args +
+                   " --spp 2 --bayes-oracle 100000000 2>&1").c_str(), "r");
+  REQUIRE(p);
+  char buf[4096];
+  for (size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) r.output.append(buf, n);
+  int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  INFO(r.output);
+  CHECK(r.status == 130);
+  CHECK(r.output.find("interrupted before the first pass; nothing written") != std::string::npos);
+  std::map<std::string, std::string> after;
+  for (auto& e : std::filesystem::directory_iterator(out)) after[e.path().string()] = slurp(e.path().string());
+  CHECK(after == before);
+  // Cut short after uniform's passes, in bayes's warm-up: the summary covers uniform, and the earlier bayes images
+  // (which it does not describe) are gone.
+  REQUIRE(std::filesystem::exists(out + "/bayes.exr"));
+  p = popen(("timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " compare " + s.json +
+             " --reference " + s.ref + " --samplers uniform,bayes --out " + out +
+             " --threads 1 --quiet --spp 2 --bayes-oracle 100000000 2>&1").c_str(), "r");
+  REQUIRE(p);
+  while (fread(buf, 1, sizeof buf, p) > 0) {}
+  st = pclose(p);
+  CHECK(WIFEXITED(st));
+  CHECK(WEXITSTATUS(st) == 130);
+  CHECK(std::filesystem::exists(out + "/uniform.exr"));
+  CHECK(!std::filesystem::exists(out + "/bayes.exr"));
+  CHECK(!std::filesystem::exists(out + "/bayes_error.png"));
+  CHECK(slurp(out + "/summary.md").find("Interrupted") != std::string::npos);
+}
+
 TEST_CASE("compare repeats runs with consecutive seeds and reports mean and deviation", "[compare]") {
   compare_scene s;
   std::string out = s.dir / "out";
