@@ -258,11 +258,11 @@ int run_render(const render_options& o) {
 
   uint64_t fingerprint = render_fingerprint(scene, params);
   const uint64_t reference_key = reference_hash(references.empty() ? nullptr : &references[0]);
-  if (o.stop_after_passes == 0)  // (the render's set-up calls restore)
-    params.restore = [](render_result&, light_sampler&) { std::raise(SIGINT); };
-  if (!o.resume.empty())
-    params.restore = [&, setup_signal = o.stop_after_passes == 0](render_result& r, light_sampler& s) {
+  const bool setup_signal = o.stop_after_passes == 0;  // (testing: the render's set-up calls restore)
+  if (setup_signal || !o.resume.empty())
+    params.restore = [&](render_result& r, light_sampler& s) {
       if (setup_signal) std::raise(SIGINT);
+      if (o.resume.empty()) return;
       uint64_t measured = decode_checkpoint(resume_bytes, o.resume, fingerprint, params.pass_weighting, r, s);
       // The log is one error curve against one reference: rows measured against another one (or none) keep their
       // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
