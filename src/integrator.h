@@ -228,10 +228,15 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
         }
       }
       st.nee_zero += value == 0;
+      // An estimate that overflowed (a receiver a hair from a lamp of radiance near float's limit) is dropped from
+      // the image with its path (bad_samples, below); a learner must not record it either: an infinite z makes a
+      // pair's mean inf and its squared deviations NaN for good.
       if constexpr (Sampler::learns) {
-        t0 = tm.start();
-        sink.record(nee_event<typename Sampler::context>{&ctx, choice, value, pixel, added, added_total});
-        tm.stop(prof_record, t0);
+        if (std::isfinite(value) && std::isfinite(added) && std::isfinite(added_total)) {
+          t0 = tm.start();
+          sink.record(nee_event<typename Sampler::context>{&ctx, choice, value, pixel, added, added_total});
+          tm.stop(prof_record, t0);
+        }
       }
     }
     if (last) break;
