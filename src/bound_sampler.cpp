@@ -6,7 +6,7 @@
 namespace bl {
 
 void bound_sampler::prepare(context& ctx, const shade_point& sp) const {
-  locate_region(ctx, regions, sp);
+  locate_region(ctx, regions, sp, true);
   if (ctx.count == 1) {
     ctx.cdf[0] = 0;
     ctx.cdf[1] = 1;
@@ -21,6 +21,7 @@ void bound_sampler::prepare(context& ctx, const shade_point& sp) const {
 }
 
 void bound_sampler::learn(std::vector<row_state>& rows) {
+  if (regions.shared_cut) return;
   std::vector<const region_requests*> r;
   for (const row_state& row : rows) r.push_back(&row);
   create_requested_regions(regions, *tree, r);

@@ -21,13 +21,16 @@ struct bound_sampler {
   region_state regions;
   float sun_sin = 0, sun_cos = 1;
 
-  void locate(context& ctx, const shade_point& sp) const { locate_region(ctx, regions, sp); }
+  void locate(context& ctx, const shade_point& sp) const { locate_region(ctx, regions, sp, true); }
   void prepare(context& ctx, const shade_point& sp) const;
   light_choice sample(const context& ctx, double u, double u_inner) const {
     return sample_cut(ctx, *tree, *lights, u, u_inner);
   }
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
-  void record(row_state& row, const nee_event<context>& e) const { row.add(*e.context); }
+    // With a cut shared by every region (a handful of lights) regions change nothing: none are requested.
+  void record(row_state& row, const nee_event<context>& e) const {
+    if (!regions.shared_cut) row.add(*e.context);
+  }
   void sample_done(row_state&, int, vec3f) const {}
   void learn(std::vector<row_state>& rows);
   void begin_frame(double) {}  // regions and cuts do not depend on the sun's direction

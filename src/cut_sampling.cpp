@@ -7,10 +7,37 @@
 
 namespace bl {
 
-void locate_region(cut_context& ctx, const region_state& regions, const shade_point& sp) {
+namespace {
+// Points the context at a region's cut, pairs and members.
+void use_region(cut_context& ctx, const region_state& regions, const region_entry& e) {
+  ctx.region = e.id;
+  ctx.region_key = e.key;
+  ctx.pair_base = e.pair_offset;
+  ctx.count = e.cut_size;
+  ctx.nodes = regions.cut_nodes.data() + e.cut_offset;
+  ctx.tree_count = ctx.count - (regions.has_sun ? 1 : 0);
+  ctx.pair_count = e.pair_count;
+  ctx.members = regions.pair_node.data() + e.pair_offset;
+  ctx.member_begin = regions.member_begin.data() + e.cut_offset;
+  ctx.group_base = e.cut_offset;
+  ctx.cut_count = ctx.count, ctx.cut_tree_count = ctx.tree_count, ctx.cut_nodes = ctx.nodes;
+}
+}  // namespace
+
+void locate_region(cut_context& ctx, const region_state& regions, const shade_point& sp, bool cut_only) {
   ctx.p = sp.p;
   ctx.n = sp.n;
   ctx.albedo = sp.albedo;
+  // A sampler that reads only the cut, in a scene whose regions all share cut 0: the root's entry serves every point
+  // (no cell key, no lookup).
+  if (cut_only && regions.shared_cut) {
+    constexpr uint64_t shared_key = ~uint64_t(1);  // a marker no lookup sets (cell keys use fewer bits)
+    if (ctx.fine_key == shared_key) return;
+    ctx.fine_key = shared_key;
+    const region_entry* e = find_region_entry(regions, regions.key[size_t(regions.root)]);
+    use_region(ctx, regions, *e);
+    return;
+  }
   uint64_t key = fine_region_key(regions.grid, sp.p);
   // Deep path vertices are few per cell and scattered: they use (and pool their samples in) coarse regions,
   // whose small table stays in cache.
@@ -22,17 +49,7 @@ void locate_region(cut_context& ctx, const region_state& regions, const shade_po
     const region_entry* e = find_region_entry(regions, key);
     if (!e && !coarse) e = find_region_entry(regions, parent_region_key(regions.grid, key, 1));
     if (!e) e = find_region_entry(regions, regions.key[size_t(regions.root)]);
-    ctx.region = e->id;
-    ctx.region_key = e->key;
-    ctx.pair_base = e->pair_offset;
-    ctx.count = e->cut_size;
-    ctx.nodes = regions.cut_nodes.data() + e->cut_offset;
-    ctx.tree_count = ctx.count - (regions.has_sun ? 1 : 0);
-    ctx.pair_count = e->pair_count;
-    ctx.members = regions.pair_node.data() + e->pair_offset;
-    ctx.member_begin = regions.member_begin.data() + e->cut_offset;
-    ctx.group_base = e->cut_offset;
-    ctx.cut_count = ctx.count, ctx.cut_tree_count = ctx.tree_count, ctx.cut_nodes = ctx.nodes;
+    use_region(ctx, regions, *e);
   }
 }
 

@@ -62,7 +62,8 @@ struct cut_context {
 
 // Fills the point and region part of a context. The region part is kept while the cell stays the same (contexts
 // live for one pass, during which regions do not change).
-void locate_region(cut_context& ctx, const region_state& regions, const shade_point& sp);
+// `cut_only`: the caller reads only the region's cut (the bound sampler), so with a shared cut the root serves.
+void locate_region(cut_context& ctx, const region_state& regions, const shade_point& sp, bool cut_only = false);
 
 // Bound-based weight of cluster `node` (a tree node or sun_cluster) at (p, n): its importance, as a
 // distance-free numerator and inv_d2 = 1 / d^2 of the regression distance (1 for the sun).

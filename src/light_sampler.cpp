@@ -32,9 +32,10 @@ std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_g
 }
 
 // Regions of a cut-based sampler: the grid, the root, and the regions of directly visible surfaces.
-// `members`: whether clusters are refined into learned members (bayes with the region prior only).
+// `learned`: whether the sampler keeps statistics per region (bayes), so that regions matter even with a shared
+// cut; `members`: whether clusters are refined into learned members (bayes with the region prior only).
 region_state make_regions(const sampler_params& params, const render_inputs& in, const light_tree_data& tree,
-                          bool members = false) {
+                          bool learned, bool members = false) {
   region_params rp = params.regions;
   rp.max_cut = std::min(std::max(rp.max_cut, 1), max_cut_entries - 1);
   // Members by default in direct illumination only: there NEE at the first hit is the whole estimate, while in path
@@ -42,6 +43,8 @@ region_state make_regions(const sampler_params& params, const render_inputs& in,
   if (rp.max_members < 0) rp.max_members = in.max_depth == 1 ? region_params::auto_members : 0;
   rp.max_members = members ? std::min(rp.max_members, max_cut_entries - 1) : 0;
   region_state s = make_region_state(in.scene->bounds, tree, in.lights->sun != invalid_id, rp);
+  // The bound sampler reads only cuts: with one cut shared by all regions it needs no region but the root.
+  if (s.shared_cut && !learned) return s;
   add_regions(s, tree, camera_region_keys(in, s.grid));
   return s;
 }
@@ -96,7 +99,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.lights = &lights;
       s.sun_sin = sun_sin;
       s.sun_cos = sun_cos;
-      s.regions = make_regions(params, in, tree);
+      s.regions = make_regions(params, in, tree, false);
       return s;
     }
     case sampler_kind::donikian: {
@@ -105,7 +108,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       b.lights = &lights;
       b.sun_sin = sun_sin;
       b.sun_cos = sun_cos;
-      b.regions = make_regions(params, in, tree);
+      b.regions = make_regions(params, in, tree, false);
       region_params rp = params.regions;
       rp.max_cut = std::min(std::max(rp.max_cut, 1), max_cut_entries - 1);
       return make_donikian_sampler(tree, lights, std::move(b), in.camera.width, in.camera.height, params.donikian, rp,
@@ -122,7 +125,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.power = power_sampler{make_discrete(lights.power.data(), lights.count)};
       if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
         s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);
-      s.regions = make_regions(params, in, tree, s.params.region_prior);
+      s.regions = make_regions(params, in, tree, true, s.params.region_prior);
       s.add_pairs(0);
       refresh_weights(s.stats, &s.regions.pair_parent, s.params);
       s.refresh_groups(nullptr);

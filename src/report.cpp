@@ -43,8 +43,13 @@ std::string render_summary(const render_result& r, const std::vector<std::string
     s += buf;
   }
   if (r.regions > 0) {
-    std::snprintf(buf, sizeof buf, "; %d regions, %.1f clusters per region, %.1f MB sampler state", r.regions,
-                  double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));
+    // One region: a cut shared by all (a handful of lights), which the bound sampler reads from the root alone.
+    if (r.regions == 1)
+      std::snprintf(buf, sizeof buf, "; 1 region, %.0f clusters, %.1f MB sampler state", double(r.pairs),
+                    double(r.sampler_bytes) / (1 << 20));
+    else
+      std::snprintf(buf, sizeof buf, "; %d regions, %.1f clusters per region, %.1f MB sampler state", r.regions,
+                    double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));
     s += buf;
   }
   if (r.fallback_spp > 0) {

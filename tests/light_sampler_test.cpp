@@ -597,6 +597,44 @@ TEST_CASE("coarse regions keep within the pair budget of their own, and the pend
   for (uint64_t key : rooted) CHECK_FALSE(add_pending(s, key, 1u << 20));
 }
 
+TEST_CASE("under a cut shared by every region the bound sampler keeps the root alone and chooses as before",
+          "[samplers][regions]") {
+  // A handful of lights (here up to 64 by option): every region's cut is cut 0, so regions cannot change what the
+  // bound sampler (which reads only cuts) chooses. It used to create a region for every cell its points reached and
+  // look the cell up at every vertex (20249 regions, 4.4 MB in the Cornell box at 640 x 480) for nothing.
+  auto t = make_test_scene(true);
+  sampler_params sp;
+  sp.kind = sampler_kind::bound;
+  sp.regions.shared_cut_lights = 64;
+  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+  bound_sampler& b = std::get<bound_sampler>(ls);
+  REQUIRE(b.regions.shared_cut);
+  CHECK(b.regions.key.size() == 1);
+  // Recording and learning create nothing.
+  std::vector<shade_point> pts = shading_points(*t, 200, 5);
+  std::vector<bound_sampler::row_state> rows(1);
+  auto ctx = std::make_unique<cut_context>();
+  for (const shade_point& p : pts) {
+    b.prepare(*ctx, p);
+    light_choice c = b.sample(*ctx, 0.5, 0.5);
+    b.record(rows[0], nee_event<cut_context>{ctx.get(), c, 1.0f, 0, 1.0f, 1.0f});
+  }
+  b.learn(rows);
+  CHECK(b.regions.key.size() == 1);
+  // The regions it no longer creates held the same cut: a point finds the same clusters through them.
+  region_state seeded = b.regions;
+  add_regions(seeded, t->tree, reached_fine_keys(*t, seeded.grid));
+  REQUIRE(seeded.key.size() > 20);
+  auto via_cell = std::make_unique<cut_context>();
+  int differ = 0;
+  for (const shade_point& p : pts) {
+    locate_region(*ctx, b.regions, p, true);
+    locate_region(*via_cell, seeded, p, false);
+    if (ctx->count != via_cell->count || !std::equal(ctx->nodes, ctx->nodes + ctx->count, via_cell->nodes)) differ++;
+  }
+  CHECK(differ == 0);
+}
+
 TEST_CASE("a scene without any light gives empty light selections", "[samplers]") {
   mesh_builder b;
   int floor = b.add_material({0.5f, 0.5f, 0.5f});
