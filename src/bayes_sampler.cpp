@@ -88,6 +88,8 @@ void bayes_sampler::prepare(context& ctx, const shade_point& sp) const {
   if (ctx.tree_count < ctx.count)
     num[ctx.tree_count] = cluster_bound_parts(*tree, *lights, sun_cluster, sp.p, sp.n, sun_sin, sun_cos,
                                               inv_d2[ctx.tree_count]);
+  for (int j = ctx.count; j < ((ctx.count + 3) & ~3); j++)  // padding lanes, read four at a time below
+    num[j] = 0, inv_d2[j] = 1;
   double w[max_cut_entries], b[max_cut_entries];
   double sum_w = 0, sum_b = 0;
   if (params.second_moment) {
@@ -255,6 +257,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
     return;
   }
   alignas(16) double w[max_cut_entries + 3];
+  for (int j = ctx.count; j < ((ctx.count + 3) & ~3); j++) wf[j] = 0;  // padding lanes never written above
   for (int j = 0; j < ctx.count; j += 4) {  // to double, four at a time (wf has room for the padding lanes)
     __m128 x = _mm_load_ps(wf + j);
     _mm_store_pd(w + j, _mm_cvtps_pd(x));

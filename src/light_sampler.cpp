@@ -6,6 +6,9 @@
 
 #include <algorithm>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 namespace bl {
 
 namespace {
@@ -13,19 +16,28 @@ namespace {
 constexpr sampler_kind all_kinds[] = {sampler_kind::uniform, sampler_kind::power,    sampler_kind::bvh,
                                       sampler_kind::bound,   sampler_kind::donikian, sampler_kind::bayes};
 
-// Fine region keys of the first hits of rays through every pixel centre (sorted, unique).
+// Fine region keys of the first hits of rays through every pixel centre (sorted, unique), rows traced in parallel
+// (the sort makes the result independent of the split).
 std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_grid_data& grid) {
-  std::vector<uint64_t> keys;
   int w = in.camera.width, h = in.camera.height;
-  keys.reserve(size_t(w) * size_t(h));
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++) {
-      vec3f dir = camera_ray_dir(in.camera, float(x) + 0.5f, float(y) + 0.5f);
-      hit_info hit = intersect(*in.bvh, in.camera.eye, dir);
-      if (hit.tri == invalid_id) continue;
-      surface_point sp = eval_surface(*in.scene, hit.tri, hit.b1, hit.b2, dir);
-      keys.push_back(fine_region_key(grid, sp.p));
+  std::vector<std::vector<uint64_t>> rows(size_t(std::max(h, 0)));
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& range) {
+    for (int y = range.begin(); y < range.end(); y++) {
+      std::vector<uint64_t>& row = rows[size_t(y)];
+      for (int x = 0; x < w; x++) {
+        vec3f dir = camera_ray_dir(in.camera, float(x) + 0.5f, float(y) + 0.5f);
+        hit_info hit = intersect(*in.bvh, in.camera.eye, dir);
+        if (hit.tri == invalid_id) continue;
+        surface_point sp = eval_surface(*in.scene, hit.tri, hit.b1, hit.b2, dir);
+        uint64_t key = fine_region_key(grid, sp.p);
+        if (row.empty() || row.back() != key) row.push_back(key);  // neighbours often share a cell
+      }
+      std::sort(row.begin(), row.end());
+      row.erase(std::unique(row.begin(), row.end()), row.end());
     }
+  });
+  std::vector<uint64_t> keys;
+  for (const auto& row : rows) keys.insert(keys.end(), row.begin(), row.end());
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   return keys;

@@ -314,6 +314,9 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   in.seed = params.seed;
   in.stratify = params.stratify;
   int frames = std::max(1, params.frames);
+  // The set-up (light tree, the regions of the first hits) runs on at most --threads threads too.
+  int threads = params.threads > 0 ? params.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  tbb::global_control allow(tbb::global_control::max_allowed_parallelism, size_t(threads));
   auto t0 = clock_type::now();
   // The first render of a command that installed the handlers sets up as the loader does: a signal ends it at once
   // (before, the signal waited for the light tree and regions, seconds in a large scene, and the render that
