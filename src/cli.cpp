@@ -421,8 +421,9 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "NEE samples a fine cell asks for before it gets its own region (default 16)")
       ->check(CLI::Range(1, 1 << 30))->group(grp);
   r->add_option("--region-budget", o.regions.max_pairs,
-                "Most (region, cluster) pairs before coarser regions serve (default 1572864)")
-      ->check(CLI::Range(int64_t(1), int64_t(1) << 40))->group(grp);
+                "Most (region, cluster) pairs before coarser regions serve (default 1572864, at most 2^29)")
+      // Pair offsets are int: fine and coarse pairs (each up to the budget) must stay below 2^31.
+      ->check(CLI::Range(int64_t(1), int64_t(1) << 29))->group(grp);
   const char* bg = "Bayesian sampler (bayes): prior strengths and ablations";
   r->add_option("--bayes-pmf", o.bayes_pmf, "second-moment (the paper) or mean (ablation: PMF from the mean only)")
       ->check(CLI::IsMember({"second-moment", "mean"}))->group(bg);

@@ -172,6 +172,7 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " -o " + (s.dir / "out.jpg"), "unknown image format"},
       {"render " + s.json + " --bogus", "--bogus"},
       {"render " + s.json + " --shared-cut-lights -1", "--shared-cut-lights"},
+      {"render " + s.json + " --region-budget 536870913", "--region-budget"},  // int pair offsets: 2^29 at most
       // NaN passes every range comparison: each real-valued option rejects it (and infinities) itself.
       {"render " + s.json + " --time nan", "--time"},
       {"render " + s.json + " --pass-weighting nan", "--pass-weighting"},
