@@ -303,9 +303,10 @@ int find_region(const region_state& s, uint64_t fine_key) {
 }
 
 int add_regions(region_state& s, const light_tree_data& tree, const std::vector<uint64_t>& fine_keys) {
-  // The candidates in key order (each fine key after its coarse parent, if that is new); their cuts and members are
-  // computed in parallel (each a function of its key only); then, in the same order, coarse regions are created and
-  // fine ones while their actual pairs fit the budget. Ids follow this order, so they do not depend on threads.
+  // The candidates in key order (each fine key after its coarse parent, if that is new); chunk by chunk their cuts and
+  // members are computed in parallel (each a function of its key only); then, in the same order, coarse regions are
+  // created and fine ones while their actual pairs fit the budget. Ids follow this order, so they do not depend on
+  // threads.
   struct pending {
     uint64_t key;
     uint64_t parent_key;  // empty_region_key for coarse regions
@@ -329,14 +330,6 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
     }
     if (!coarse_only) todo.push_back({key, ckey});
   }
-  size_t cuts_needed = s.shared_cut ? 0 : todo.size();
-  std::vector<std::vector<int>> cuts(cuts_needed), members(s.members ? cuts_needed : 0), group(members.size());
-  if (!s.shared_cut)
-    tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) {
-      bbox3f box = padded(region_box(s.grid, todo[i].key));
-      cuts[i] = compute_light_cut(tree, box, s.has_sun, s.params);
-      if (s.members) compute_members(tree, box, cuts[i], s.params.max_members, members[i], group[i]);
-    });
   // Coarse regions are few against the fine ones (a coarse cell holds 512 fine ones: in the data/ scenes their pairs
   // are 2-6 % of all) and take no part in the budget while their own pairs stay within it; then (a fine grid whose
   // fine regions the budget turned down, a coarse region for each: 7.6 times the budget at --grid 1024) they are
@@ -345,24 +338,53 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
   for (size_t r = 0; r < s.key.size(); r++)
     if (is_coarse_key(s.key[r])) coarse_pairs += s.pair_count[r];
   const int64_t coarse_allowance = s.params.max_pairs;
+  // In chunks, so that once the budget is spent no cut is computed for a key it would turn down: with a very fine
+  // grid and --region-min-samples 1 nearly every NEE sample asked for a new cell, and every one had its cut and
+  // members computed and held (1-12 KB each) before the budget was looked at: 2.8 GB at 64 x 48, 64 spp.
+  constexpr size_t chunk = 4096;
+  std::vector<std::vector<int>> cuts, members, group;
+  std::vector<char> computed;
   int added = 0;
-  for (size_t i = 0; i < todo.size(); i++) {
-    bool coarse = todo[i].parent_key == empty_region_key;
-    int64_t n = s.shared_cut ? s.cut_size[0] : s.members ? int64_t(members[i].size()) : int64_t(cuts[i].size());
-    // Over budget, the coarse region serves for good (the key is marked in the pending table and not tried again).
-    if (coarse ? coarse_pairs + n > coarse_allowance : s.pairs + n > s.params.max_pairs) {
-      pending_slot(s, todo[i].key).id = over_budget;
-      continue;
+  for (size_t c0 = 0; c0 < todo.size(); c0 += chunk) {
+    const size_t c1 = std::min(todo.size(), c0 + chunk), m = c1 - c0;
+    // A region has at least one pair (the sun's, or a cluster whose bound over the box is positive; one of none is
+    // sampled exactly as its coarse region or the root would be, none of whose clusters reaches the box either).
+    computed.assign(m, 0);
+    for (size_t i = 0; i < m; i++) {
+      computed[i] = todo[c0 + i].parent_key == empty_region_key ? coarse_pairs < coarse_allowance
+                                                                : s.pairs < s.params.max_pairs;
+      s.cuts_computed += computed[i] && !s.shared_cut;
     }
-    int parent = coarse ? invalid_id : find_region_key(s, todo[i].parent_key);
-    if (!coarse && parent == invalid_id) {  // its coarse region was turned down just now
-      pending_slot(s, todo[i].key).id = over_budget;
-      continue;
+    if (!s.shared_cut) {
+      cuts.assign(m, {});
+      members.assign(s.members ? m : 0, {});
+      group.assign(members.size(), {});
+      tbb::parallel_for(size_t(0), m, [&](size_t i) {
+        if (!computed[i]) return;
+        bbox3f box = padded(region_box(s.grid, todo[c0 + i].key));
+        cuts[i] = compute_light_cut(tree, box, s.has_sun, s.params);
+        if (s.members) compute_members(tree, box, cuts[i], s.params.max_members, members[i], group[i]);
+      });
     }
-    if (coarse) coarse_pairs += n;
-    append_region(s, todo[i].key, s.shared_cut ? nullptr : &cuts[i], s.members ? &members[i] : nullptr,
-                  s.members ? &group[i] : nullptr, parent, &tree);
-    added++;
+    for (size_t i = 0; i < m; i++) {
+      const pending& t = todo[c0 + i];
+      bool coarse = t.parent_key == empty_region_key;
+      int64_t n = s.shared_cut ? s.cut_size[0] : s.members ? int64_t(members[i].size()) : int64_t(cuts[i].size());
+      // Over budget, the coarse region serves for good (the key is marked in the pending table and not tried again).
+      if (!computed[i] || (coarse ? coarse_pairs + n > coarse_allowance : s.pairs + n > s.params.max_pairs)) {
+        pending_slot(s, t.key).id = over_budget;
+        continue;
+      }
+      int parent = coarse ? invalid_id : find_region_key(s, t.parent_key);
+      if (!coarse && parent == invalid_id) {  // its coarse region was turned down just now
+        pending_slot(s, t.key).id = over_budget;
+        continue;
+      }
+      if (coarse) coarse_pairs += n;
+      append_region(s, t.key, s.shared_cut ? nullptr : &cuts[i], s.members ? &members[i] : nullptr,
+                    s.members ? &group[i] : nullptr, parent, &tree);
+      added++;
+    }
   }
   return added;
 }

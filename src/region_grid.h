@@ -86,6 +86,7 @@ struct region_state {
                                        // -1: over the pair budget, never created)
   size_t pending_count = 0;
   int root = 0;
+  int64_t cuts_computed = 0;           // cuts add_regions computed (a statistic: not saved, not in the image)
 };
 
 constexpr uint64_t empty_region_key = ~uint64_t(0);
