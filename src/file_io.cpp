@@ -85,9 +85,14 @@ std::string read_file(const std::string& path) {
 
 // Writes bytes straight into an existing non-regular file (device, FIFO, socket): renaming over it would
 // replace the node itself. Errors such as ENOSPC from /dev/full are reported like any other.
+// A FIFO is opened without blocking: with no process reading it a blocking open waited for one for ever, deaf to
+// SIGINT and SIGTERM (their handlers only set a flag, and the open restarts); now it fails at once (ENXIO). With a
+// reader the writes block as usual.
 static void write_direct(const std::string& path, const std::string& bytes) {
-  int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0 && errno == ENXIO) throw write_failure(path, "a FIFO that no process is reading");
   if (fd < 0) throw write_failure(path, reason(errno));
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
   int err = write_all(fd, bytes.data(), bytes.size());
   int cerr = close_checked(fd);
   if (err == 0) err = cerr;

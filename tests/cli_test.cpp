@@ -6,13 +6,16 @@
 
 #include <catch2/catch.hpp>
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <fstream>
+#include <thread>
 
 using namespace bl;
 using namespace bl::test;
@@ -512,6 +515,40 @@ TEST_CASE("outputs that would overwrite an input or each other are refused befor
                               (s.dir / "c.pfm"));
   INFO(again.output);
   CHECK(again.status == 0);
+}
+
+TEST_CASE("an output FIFO that no process reads fails at once, one with a reader gets the image", "[cli]") {
+  // Opening the FIFO blocked for ever (and SIGINT/SIGTERM could not end the wait) when no process read it.
+  tiny_scene s;
+  const std::string fifo = s.dir / "out.pfm";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  for (const std::string& opt : {" -o " + fifo, " -o " + (s.dir / "a.pfm") + " --log " + fifo}) {
+    auto r = run_bayeslight("render " + s.json + " --quiet" + opt);
+    INFO(opt << "\n" << r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find("no process is reading") != std::string::npos);
+  }
+  // With a reader (this process, opened before the render starts) the image goes through the FIFO.
+  int rfd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  REQUIRE(rfd >= 0);
+  std::string bytes;
+  std::atomic<bool> done{false};
+  std::thread reader([&] {
+    char buf[4096];
+    for (;;) {
+      ssize_t k = ::read(rfd, buf, sizeof buf);
+      if (k > 0) bytes.append(buf, size_t(k));
+      else if (k == 0 && done) break;  // EOF after the writer closed (0 before any writer opened too: wait for done)
+      else std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
+  auto r = run_bayeslight("render " + s.json + " --quiet -o " + fifo);
+  done = true;
+  reader.join();
+  ::close(rfd);
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(bytes.rfind("PF\n", 0) == 0);
 }
 
 TEST_CASE("inputs that are not regular files are refused, never read", "[cli]") {
