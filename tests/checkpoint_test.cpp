@@ -275,7 +275,8 @@ TEST_CASE("the checkpoint fingerprint sees every texture option of every materia
 
 TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed", "[checkpoint]") {
   // Indices out of range crashed the resumed render, a full pending table or a pair whose parent has a parent made it
-  // loop for ever, non-finite film values gave NaN pixels: each is an input error naming the file now.
+  // loop for ever, non-finite film values gave NaN pixels (and values beyond float's range infinite ones): each is an
+  // input error naming the file now.
   temp_dir d;
   auto args = [&](const char* sampler) {
     return "render " + source_path("data/cornell/direct.json") + " --sampler " + std::string(sampler) +
@@ -301,6 +302,8 @@ TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed
       for (uint64_t k = 0; k < f.pending_slots; k++) c.put<uint64_t>(f.pending + 16 * k, k);
     });
     edit("film NaN", [&](checkpoint_bytes& c) { c.put<double>(f.film, std::nan("")); });
+    // Finite in double, but a mean beyond float's range: the resumed render wrote an infinite pixel with exit 0.
+    edit("film beyond float", [&](checkpoint_bytes& c) { c.put<double>(f.film, 1e300); });
     edit("film weight infinite", [&](checkpoint_bytes& c) { c.put<double>(f.film_weight, HUGE_VAL); });
     edit("passes", [&](checkpoint_bytes& c) { c.put<int>(f.passes, 2147483647); });
     if (bayes) edit("statistics NaN", [&](checkpoint_bytes& c) { c.put<double>(f.moments, std::nan("")); });
