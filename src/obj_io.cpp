@@ -229,7 +229,9 @@ static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, fo
   int index = same != loaded.end() ? same->second : int(mesh.textures.size());
   if (same == loaded.end()) {
     try {
-      mesh.textures.push_back(load_texture(path));
+      uint64_t used = 0;
+      for (const texture_data& t : mesh.textures) used += texture_bytes(t);
+      mesh.textures.push_back(load_texture(path, max_textures_bytes - std::min(used, max_textures_bytes)));
     } catch (const input_error& e) {
       throw input_error(mtl_path, line, std::string(statement) + ": " + e.what());
     }

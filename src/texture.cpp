@@ -206,7 +206,7 @@ texture_data texture_from_texels8(std::string path, int width, int height, int c
   return t;
 }
 
-texture_data load_texture(const std::string& path) {
+texture_data load_texture(const std::string& path, uint64_t budget) {
   std::string bytes = read_image_file(path);
   if (bytes.empty()) throw input_error(path, "cannot decode image: empty file");
   if (bytes.size() > size_t(std::numeric_limits<int>::max())) throw input_error(path, "image file too large");
@@ -243,11 +243,17 @@ texture_data load_texture(const std::string& path) {
   if ((long long)bytes.size() < uncompressed_size(bytes, w, h))
     throw input_error(path, "cannot decode image: truncated");
 
+  const bool sixteen = stbi_is_16_bit_from_memory(data, len);
+  const uint64_t decoded = uint64_t(texels) * uint64_t(n) * (sixteen ? 2 : 1);
+  if (decoded > budget)
+    throw input_error(path, "image of " + std::to_string(w) + "x" + std::to_string(h) + " texels (" +
+                                std::to_string(decoded >> 20) + " MiB decoded) would take the scene's textures past " +
+                                std::to_string(max_textures_bytes >> 30) + " GiB in all");
   texture_data tex;
   tex.path = path;
   stbi_set_flip_vertically_on_load_thread(0);
   int dw = 0, dh = 0, dn = 0;
-  if (stbi_is_16_bit_from_memory(data, len)) {
+  if (sixteen) {
     std::unique_ptr<stbi_us, stbi_deleter> px(stbi_load_16_from_memory(data, len, &dw, &dh, &dn, 0));
     if (!px) throw input_error(path, "cannot decode image: " + stb_reason());
     if (dw != w || dh != h || dn < 1 || dn > 4) throw input_error(path, "cannot decode image: inconsistent header");

@@ -15,6 +15,9 @@ namespace bl {
 
 // Largest accepted image (width * height); 2^27 texels is 512 MiB of 8-bit RGBA (1 GiB at 16 bits).
 constexpr long long max_texture_texels = 1LL << 27;
+// Most memory all of a scene's decoded textures may take together (each within max_texture_texels): a few MB of
+// well-compressed PNGs could otherwise claim any amount (four 1 MB files of 2^27 16-bit RGBA texels took 5 GB).
+constexpr uint64_t max_textures_bytes = uint64_t(1) << 32;
 
 // One decoded texture, kept as the file's own 8- or 16-bit channels (a quarter of the memory of float RGB + alpha:
 // a 4096² RGBA texture takes 64 MiB), decoded per lookup through a fixed table: texel_rgb is linear RGB, texel_alpha
@@ -57,7 +60,11 @@ inline bool texture_complete(const texture_data& t) {
 // 8-bit colour goes through the srgb8_to_linear table, 16-bit colour through the same sRGB curve in float;
 // alpha is linear (value / max). HDR, GIF, PSD, PIC and PNM files are refused, as are images larger than
 // max_texture_texels.
-texture_data load_texture(const std::string& path);
+// `budget`: the decoded bytes still allowed (max_textures_bytes less what the scene's other textures take); an image
+// that would take more is refused before it is decoded.
+texture_data load_texture(const std::string& path, uint64_t budget = max_textures_bytes);
+// Decoded bytes a texture holds.
+inline uint64_t texture_bytes(const texture_data& t) { return t.texels8.size() + 2 * uint64_t(t.texels16.size()); }
 
 // A texture of 8-bit texels (width * height * channels values, row-major, top row first; colour sRGB-encoded).
 texture_data texture_from_texels8(std::string path, int width, int height, int channels, std::vector<uint8_t> texels);

@@ -196,6 +196,19 @@ TEST_CASE("16-bit images decode through the same sRGB curve", "[texture]") {
   CHECK(t.texels16.size() == size_t(2 * t.channels));
 }
 
+TEST_CASE("a texture that would take the scene's textures past their budget is refused before decoding", "[texture]") {
+  // Nothing capped the sum: four 1 MB PNGs of 2^27 16-bit RGBA texels each decoded to 5 GB (a review). The loader
+  // passes what the scene's other textures leave of max_textures_bytes; the 16-bit 2x1 grey+alpha image takes 8 bytes.
+  temp_dir dir;
+  write_bytes(dir.file("p16.png"), std::string(reinterpret_cast<const char*>(png16), sizeof png16));
+  CHECK(texture_bytes(load_texture(dir.file("p16.png"), 8)) == 8);
+  CHECK_THROWS_WITH(load_texture(dir.file("p16.png"), 7),
+                    Catch::Contains("p16.png") && Catch::Contains("past 4 GiB in all"));
+  auto path = write_png(dir, "rgb.png", 3, 2, 3, std::vector<unsigned char>(18, 7));  // 8-bit: 18 bytes
+  CHECK(texture_bytes(load_texture(path, 18)) == 18);
+  CHECK_THROWS_WITH(load_texture(path, 17), Catch::Contains("past 4 GiB"));
+}
+
 TEST_CASE("missing garbage truncated and unsupported images are input errors", "[texture]") {
   temp_dir dir;
   CHECK_THAT(texture_error(dir.file("none.png")), Catch::Contains("none.png") && Catch::Contains("cannot open"));
