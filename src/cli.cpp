@@ -655,7 +655,8 @@ int run_cli(int argc, char** argv) {
     return exit_bad_input;
   } catch (const output_error& e) {
     std::fprintf(stderr, "bayeslight: error: %s\n", e.what());
-    return exit_failure;
+    // (A signal that ended an output's wait, for a FIFO's reader: the interrupted run's status.)
+    return interrupt_signal() != 0 ? 128 + interrupt_signal() : exit_failure;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "bayeslight: error: out of memory\n");
     return exit_failure;

@@ -7,12 +7,14 @@
 
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <climits>
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
 #include <sys/stat.h>
+#include <thread>
 #include <unistd.h>
 
 namespace bl {
@@ -83,16 +85,24 @@ std::string read_file(const std::string& path) {
   return bytes;
 }
 
+static int (*g_fifo_wait_check)() = nullptr;
+void set_fifo_wait_check(int (*interrupted)()) { g_fifo_wait_check = interrupted; }
+
 // Writes bytes straight into an existing non-regular file (device, FIFO, socket): renaming over it would
-// replace the node itself. Errors such as ENOSPC from /dev/full are reported like any other.
-// A FIFO is opened without blocking: with no process reading it a blocking open waited for one for ever, deaf to
-// SIGINT and SIGTERM (their handlers only set a flag, and the open restarts); now it fails at once (ENXIO). With a
-// reader the writes block as usual.
-static void write_direct(const std::string& path, const std::string& bytes) {
-  int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0 && errno == ENXIO) throw write_failure(path, "a FIFO that no process is reading");
+// replace the node itself. Errors such as ENOSPC from /dev/full are reported like any other. A FIFO is opened
+// without blocking, again every 10 ms until a process reads it: a blocking open waited for one deaf to SIGINT and
+// SIGTERM (their handlers only set a flag, and the open restarted); now the wait ends when a signal arrives.
+static void write_direct(const std::string& path, const std::string& bytes, bool fifo) {
+  int fd = -1;
+  for (;;) {
+    fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | (fifo ? O_NONBLOCK : 0));
+    if (fd >= 0 || !fifo || errno != ENXIO) break;
+    if (g_fifo_wait_check && g_fifo_wait_check() != 0)
+      throw write_failure(path, "interrupted while waiting for a process to read this FIFO");
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   if (fd < 0) throw write_failure(path, reason(errno));
-  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  if (fifo) ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
   int err = write_all(fd, bytes.data(), bytes.size());
   int cerr = close_checked(fd);
   if (err == 0) err = cerr;
@@ -135,7 +145,7 @@ void write_file_atomic(const std::string& path, const std::string& bytes) {
   struct stat st {};
   const bool exists = ::stat(path.c_str(), &st) == 0;
   if (exists && !S_ISREG(st.st_mode)) {
-    write_direct(path, bytes);
+    write_direct(path, bytes, S_ISFIFO(st.st_mode));
     return;
   }
   const std::string target = rename_target(path);

@@ -1,6 +1,7 @@
 // render: pass schedule, parallel pass execution over image rows, film folding, learning, error log.
 #include "render.h"
 
+#include "file_io.h"
 #include "progress.h"
 
 #include <tbb/blocked_range.h>
@@ -417,6 +418,7 @@ void install_interrupt_handlers() {
   g_phase.store(phase_setup);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
+  set_fifo_wait_check(interrupt_signal);  // an output FIFO's wait for its reader ends on a signal too
   // A process started with them blocked (a launcher's mask is inherited) could not be interrupted at all; one that
   // arrived meanwhile is delivered now.
   sigset_t s;
