@@ -8,7 +8,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <type_traits>
 
 namespace bl {
@@ -439,6 +438,7 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
     base_ok = base_ok || result.stratum_base == p.spp;
   }
   if (!passes_ok || spp != result.spp || !base_ok) r.fail("pass state");
+  read_sampler(r, sampler);  // (before the weight: a frozen oracle model does not adapt)
   // The film's weight is a function of the passes (their spp and the weighting fixed in advance): the same sum, in
   // the same order, as the render's.
   const double weighting = sampler_adapts(sampler) ? pass_weighting : 0.0;
@@ -449,12 +449,10 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
     spp = p.spp;
   }
   if (result.film_weight != weight) r.fail("film weight");
-  // Every sample is a finite float, so a pixel's mean is within float's range: a larger value (finite in double)
-  // would be written as an infinite pixel.
-  const double film_limit = double(std::numeric_limits<float>::max()) * weight;
+  // Every sample is a finite float, so every pixel's mean converts to a finite float as the image does it (film_image);
+  // a value finite in double but beyond that (an edit) was written as an infinite pixel.
   for (double x : result.film)
-    if (!(std::fabs(x) <= film_limit)) r.fail("film");
-  read_sampler(r, sampler);
+    if (!std::isfinite(float(x / weight))) r.fail("film");
   if (auto* b = std::get_if<bayes_sampler>(&sampler); b && !b->px_var.empty() && b->px_var.size() != result.film.size() / 3)
     r.fail("fallback check");  // its columns are indexed by pixel
   if (r.pos != body.size()) r.fail("trailing data");

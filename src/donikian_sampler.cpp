@@ -4,8 +4,18 @@
 #include "cluster_bounds.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 namespace bl {
+
+// sum += v, at most float's largest value: a sample a hair from a lamp near float's limit (or many of them) would
+// make the estimate infinite for good (and the render's checkpoint unreadable); the estimates only steer the pmf.
+// (v >= 0: the sum of float additions as before, so images are unchanged below the cap.)
+static void add_capped(float& sum, float v) {
+  float t = sum + v;
+  sum = std::isfinite(t) ? t : std::numeric_limits<float>::max();
+}
 
 void donikian_row::clear() {
   requests.clear();
@@ -82,7 +92,7 @@ void donikian_sampler::record(row_state& row, const nee_event<context>& e) const
   int x = ctx.pixel % width;
   row.y = ctx.pixel / width;
   double pj = cluster_pmf(ctx, j);
-  if (pj > 0) row.sum[size_t(x) * size_t(k) + size_t(j)] += float(e.value / pj);
+  if (pj > 0) add_capped(row.sum[size_t(x) * size_t(k) + size_t(j)], float(e.value / pj));
   row.count[size_t(x)] += 1;
 }
 
@@ -95,7 +105,7 @@ void donikian_sampler::learn(std::vector<row_state>& rows) {
   for (const row_state& r : rows) {
     if (r.y < 0 || r.sum.empty()) continue;
     size_t base = size_t(r.y) * size_t(width);
-    for (size_t i = 0; i < r.sum.size(); i++) pixel_sum[base * size_t(k) + i] += r.sum[i];
+    for (size_t i = 0; i < r.sum.size(); i++) add_capped(pixel_sum[base * size_t(k) + i], r.sum[i]);
     for (int x = 0; x < width; x++) pixel_count[base + size_t(x)] += r.count[size_t(x)];
   }
   // Block estimates: sums over each block's pixels, in a fixed order.
@@ -107,7 +117,8 @@ void donikian_sampler::learn(std::vector<row_state>& rows) {
       size_t p = size_t(y) * size_t(width) + size_t(x);
       size_t b = size_t(y / params.block) * size_t(bw) + size_t(x / params.block);
       block_count[b] += pixel_count[p];
-      for (int j = 0; j < k; j++) block_sum[b * size_t(k) + size_t(j)] += pixel_sum[p * size_t(k) + size_t(j)];
+      for (int j = 0; j < k; j++)
+        add_capped(block_sum[b * size_t(k) + size_t(j)], pixel_sum[p * size_t(k) + size_t(j)]);
     }
 }
 

@@ -37,7 +37,8 @@ void render_checkpoint(const std::string& args, int spp, const temp_dir& dir, co
 TEST_CASE("interrupted and killed renders resume to the same bytes", "[checkpoint]") {
   temp_dir d;
   // bayes in direct illumination too: there its clusters are refined into members (region_params::max_members).
-  for (const char* s : {"bound", "donikian", "bayes", "bayes --max-depth 1"}) {
+  // (An oracle's frozen model does not adapt: its passes weigh alike, which the checkpoint check must know.)
+  for (const char* s : {"bound", "donikian", "bayes", "bayes --max-depth 1", "bayes --bayes-oracle 8"}) {
     INFO(s);
     std::string full = d / "full.pfm";
     REQUIRE(run_bayeslight(base_args(s) + " -o " + full).status == 0);
@@ -109,6 +110,49 @@ TEST_CASE("a render of radiance 1e28 resumes to the same bytes", "[checkpoint]")
     REQUIRE(resumed.status == 0);
     CHECK(read_file(d / "resumed.pfm") == read_file(d / "full.pfm"));
   }
+}
+
+TEST_CASE("a render of a lamp of radiance FLT_MAX in view resumes", "[checkpoint]") {
+  // Pixels whose every sample is FLT_MAX: their film sums may round a hair above FLT_MAX times the film weight, yet the
+  // image holds FLT_MAX; a range check with no room for that rounding refused such checkpoints (at 3, 8, 9, ... spp).
+  temp_dir d;
+  write_text(d / "q.obj", "mtllib q.mtl\nusemtl lamp\nv 0 0 0\nv 2e-5 0 0\nv 2e-5 2e-5 0\nv 0 2e-5 0\nf 1 2 3 4\n");
+  write_text(d / "q.mtl", "newmtl lamp\nKd 0 0 0\nKe 3.4028234663852886e38 3.4028234663852886e38 "
+                          "3.4028234663852886e38\n");
+  for (const char* sampler : {"bayes", "donikian"})
+    for (int spp : {3, 8, 9}) {
+      INFO(sampler << " " << spp << " spp");
+      std::string args = "render " + (d / "q.obj") + " --sampler " + sampler + " --width 32 --height 24 --quiet " +
+                         "--max-depth 1 --checkpoint " + (d / "ck.bin") + " -o " + (d / "a.pfm");
+      REQUIRE(run_bayeslight(args + " --spp " + std::to_string(spp)).status == 0);
+      auto resumed = run_bayeslight(args + " --spp " + std::to_string(spp + 3) + " --resume " + (d / "ck.bin"));
+      INFO(resumed.output);
+      CHECK(resumed.status == 0);
+    }
+}
+
+TEST_CASE("renders whose NEE estimates overflow float resume, learners included", "[checkpoint]") {
+  // A 2-micrometre lamp of radiance 3e38 a tenth of a micrometre above a floor: some NEE estimates overflow (dropped
+  // from the image). bayes recorded them (a pair's mean inf, its squared deviations NaN), donikian summed their
+  // overflowing ratios into its estimates: either render's own checkpoint was then refused as corrupt.
+  temp_dir d;
+  write_text(d / "t.obj", "mtllib t.mtl\nv 0 0 0\nv 1e-5 0 0\nv 1e-5 1e-5 0\nv 0 1e-5 0\nv 4e-6 4e-6 1e-7\n"
+                          "v 4e-6 6e-6 1e-7\nv 6e-6 6e-6 1e-7\nv 6e-6 4e-6 1e-7\nusemtl floor\nf 1 2 3\nf 1 3 4\n"
+                          "usemtl lamp\nf 5 6 7\nf 5 7 8\n");
+  write_text(d / "t.mtl", "newmtl floor\nKd 0.8 0.8 0.8\nnewmtl lamp\nKd 0 0 0\nKe 3e38 3e38 3e38\n");
+  for (const char* sampler : {"bayes", "donikian"})
+    for (const char* depth : {"1", "3"}) {
+      INFO(sampler << " max depth " << depth);
+      std::string args = "render " + (d / "t.obj") + " --sampler " + sampler + " --max-depth " + depth +
+                         " --width 64 --height 64 --checkpoint " + (d / "ck.bin") + " -o " + (d / "a.pfm");
+      auto first = run_bayeslight(args + " --spp 16");
+      INFO(first.output);
+      REQUIRE(first.status == 0);
+      CHECK(first.output.find("non-finite samples discarded") != std::string::npos);  // the scene does overflow
+      auto resumed = run_bayeslight(args + " --spp 24 --quiet --resume " + (d / "ck.bin"));
+      INFO(resumed.output);
+      CHECK(resumed.status == 0);
+    }
 }
 
 TEST_CASE("a finished render can be resumed further", "[checkpoint]") {
