@@ -518,16 +518,22 @@ static std::vector<uint64_t> reached_fine_keys(const test_scene& t, const region
   return keys;
 }
 
+// The test scene, small region parameters, a region state with no region yet and the fine keys its points reach.
+struct budget_case {
+  std::unique_ptr<test_scene> t = make_test_scene(false);
+  region_params rp = small_region_params();
+  region_state probe = make_region_state(t->scene.bounds, t->tree, false, rp);
+  std::vector<uint64_t> keys = reached_fine_keys(*t, probe.grid);
+  budget_case() { REQUIRE(keys.size() > 20); }
+};
+
 TEST_CASE("fine regions over the pair budget are not created, and their keys are not tried again", "[samplers][regions]") {
   // The fine cells that shading points reach, requested at once under a pair budget that holds about half of what
   // they ask for: the regions that fit are created (coarse ones within their own allowance), the others are not, and
   // their keys stay out for good: their pairs are a function of the key and the pair count only grows, so a key
   // once over the budget would only have its cut computed again at every pass, to be turned down again.
-  auto t = make_test_scene(false);
-  region_params rp = small_region_params();
-  region_state probe = make_region_state(t->scene.bounds, t->tree, false, rp);
-  std::vector<uint64_t> keys = reached_fine_keys(*t, probe.grid);
-  REQUIRE(keys.size() > 20);
+  budget_case c;
+  auto& [t, rp, probe, keys] = c;
   const int64_t base = probe.pairs;  // the root's
   add_regions(probe, t->tree, keys);
   int64_t wanted = probe.pairs - base;
@@ -566,11 +572,8 @@ TEST_CASE("fine regions over the pair budget are not created, and their keys are
 TEST_CASE("once the pair budget is spent no cut is computed for the keys it turns down", "[samplers][regions]") {
   // A fine grid with --region-min-samples 1 asks for a new cell at nearly every NEE sample: every one had its cut and
   // members computed (and held, 1-12 KB each) before the budget was looked at: 2.8 GB and 285 s for a 64 x 48 image.
-  auto t = make_test_scene(false);
-  region_params rp = small_region_params();
-  region_state probe = make_region_state(t->scene.bounds, t->tree, false, rp);
-  std::vector<uint64_t> keys = reached_fine_keys(*t, probe.grid);
-  REQUIRE(keys.size() > 20);
+  budget_case c;
+  auto& [t, rp, probe, keys] = c;
   std::vector<uint64_t> first(keys.begin(), keys.begin() + keys.size() / 2), rest(keys.begin() + keys.size() / 2,
                                                                                    keys.end());
   add_regions(probe, t->tree, first);
