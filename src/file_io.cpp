@@ -86,7 +86,7 @@ std::string read_file(const std::string& path) {
 }
 
 static int (*g_fifo_wait_check)() = nullptr;
-void set_fifo_wait_check(int (*interrupted)()) { g_fifo_wait_check = interrupted; }
+void set_fifo_wait_check(int (*signal_count)()) { g_fifo_wait_check = signal_count; }
 
 // Writes bytes straight into an existing non-regular file (device, FIFO, socket): renaming over it would
 // replace the node itself. Errors such as ENOSPC from /dev/full are reported like any other. A FIFO is opened
@@ -94,10 +94,11 @@ void set_fifo_wait_check(int (*interrupted)()) { g_fifo_wait_check = interrupted
 // SIGTERM (their handlers only set a flag, and the open restarted); now the wait ends when a signal arrives.
 static void write_direct(const std::string& path, const std::string& bytes, bool fifo) {
   int fd = -1;
+  const int signals_before = g_fifo_wait_check ? g_fifo_wait_check() : 0;
   for (;;) {
     fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | (fifo ? O_NONBLOCK : 0));
     if (fd >= 0 || !fifo || errno != ENXIO) break;
-    if (g_fifo_wait_check && g_fifo_wait_check() != 0)
+    if (g_fifo_wait_check && g_fifo_wait_check() != signals_before)
       throw write_failure(path, "interrupted while waiting for a process to read this FIFO");
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }

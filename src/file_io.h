@@ -20,9 +20,10 @@ std::string read_file(const std::string& path);
 // its target replaced. Throws output_error("cannot write PATH: reason") on any failure.
 void write_file_atomic(const std::string& path, const std::string& bytes);
 // An existing FIFO given as an output waits for a process to read it (as any writer of a FIFO does), polling this
-// function meanwhile: a non-zero value (the signal received) gives up the wait with a write_failure. The render
-// installs it with its signal handlers; without it the wait is not interruptible from here.
-void set_fifo_wait_check(int (*interrupted)());
+// function meanwhile (a count of signals received): when it changes during the wait, a signal arrived and the wait
+// gives up with a write_failure. A signal that came before (an interrupted render writing its passes) does not stop
+// the wait. The render installs it with its signal handlers; without it the wait is not interruptible from here.
+void set_fifo_wait_check(int (*signal_count)());
 
 // The same file, whether or not it exists yet (symbolic links and "." / ".." resolved).
 bool same_file(const std::string& a, const std::string& b);

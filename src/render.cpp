@@ -24,6 +24,7 @@ namespace bl {
 namespace {
 
 std::atomic<int> g_signal{0};
+std::atomic<int> g_signal_count{0};  // signals received (an output's wait ends on a new one)
 // Where the command stands, for a signal: while setting up (loading the scene; then, in the first render_frames, the
 // light tree, the sampler's regions and a checkpoint's state) nothing has been written yet, and a loader deep in a
 // large file would notice a request only once it is done, so the handler ends the process at once; afterwards it
@@ -41,6 +42,7 @@ extern "C" void on_interrupt(int sig) {
     _exit(128 + sig);
   }
   g_signal.store(sig);
+  g_signal_count.fetch_add(1);
 }
 
 using clock_type = std::chrono::steady_clock;
@@ -418,7 +420,7 @@ void install_interrupt_handlers() {
   g_phase.store(phase_setup);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
-  set_fifo_wait_check(interrupt_signal);  // an output FIFO's wait for its reader ends on a signal too
+  set_fifo_wait_check(interrupt_count);  // an output FIFO's wait for its reader ends on a signal that arrives in it
   // A process started with them blocked (a launcher's mask is inherited) could not be interrupted at all; one that
   // arrived meanwhile is delivered now.
   sigset_t s;
@@ -428,6 +430,7 @@ void install_interrupt_handlers() {
   pthread_sigmask(SIG_UNBLOCK, &s, nullptr);
 }
 int interrupt_signal() { return g_signal.load(); }
+int interrupt_count() { return g_signal_count.load(); }
 void reset_interrupt() { g_signal.store(0); }
 int interrupted_before_render() {
   g_phase.store(phase_before_render);  // until the first render sets up, a signal asks it to stop after its pass

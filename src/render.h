@@ -107,6 +107,8 @@ image_data film_image(const render_result& r);
 // state); otherwise a signal requests the render to stop after the current pass.
 void install_interrupt_handlers();
 int interrupt_signal();
+// How many SIGINT/SIGTERM the handlers have received so far.
+int interrupt_count();
 // Clears a pending interrupt request (tests).
 void reset_interrupt();
 // Ends the set-up phase (see install_interrupt_handlers). A signal noted before it (not while setting up, which

@@ -538,6 +538,21 @@ TEST_CASE("an output FIFO waits for its reader until a signal ends the wait; one
     CHECK(err.find("interrupted while waiting for a process to read this FIFO") != std::string::npos);
   }
   CHECK(std::filesystem::exists(s.dir / "a.pfm"));  // the image, written before the log
+  // A render stopped by a signal still waits for its FIFO's reader (a reader that comes a second later), and the image
+  // of its passes goes through: the wait ends only on a signal that arrives during it.
+  {
+    std::string cmd = std::string("( ") + BAYESLIGHT_BINARY + " render " + s.json + " --quiet --spp 64 " +
+                      "--stop-after-passes 3 -o " + fifo + " -o " + (s.dir / "b.pfm") + " 2>/dev/null & pid=$!; " +
+                      "sleep 1; timeout 10 cat " + fifo + " > " + (s.dir / "got.pfm") + "; wait $pid; echo $? )";
+    FILE* p = popen(cmd.c_str(), "r");
+    REQUIRE(p);
+    char buf[64] = {0};
+    REQUIRE(fgets(buf, sizeof buf, p));
+    pclose(p);
+    CHECK(std::atoi(buf) == 130);
+    CHECK(read_text(s.dir / "got.pfm").rfind("PF\n", 0) == 0);
+    CHECK(std::filesystem::exists(s.dir / "b.pfm"));
+  }
   // With a reader (this process, opened before the render starts) the image goes through the FIFO.
   int rfd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
   REQUIRE(rfd >= 0);
