@@ -27,7 +27,7 @@ struct bound_sampler {
     return sample_cut(ctx, *tree, *lights, u, u_inner);
   }
   float pmf(const context& ctx, int light) const { return cut_pmf(ctx, *tree, *lights, light); }
-    // With a cut shared by every region (a handful of lights) regions change nothing: none are requested.
+  // With a cut shared by every region (a handful of lights) regions change nothing: none are requested.
   void record(row_state& row, const nee_event<context>& e) const {
     if (!regions.shared_cut) row.add(*e.context);
   }

@@ -655,7 +655,8 @@ int run_cli(int argc, char** argv) {
     return exit_bad_input;
   } catch (const output_error& e) {
     std::fprintf(stderr, "bayeslight: error: %s\n", e.what());
-    // (A signal that ended an output's wait, for a FIFO's reader: the interrupted run's status.)
+    // An output that failed in a run a signal interrupted (a signal that ended a FIFO's wait for its reader, or a
+    // write failing while an interrupted render wrote its passes): the interrupted run's status, 128 + signal.
     return interrupt_signal() != 0 ? 128 + interrupt_signal() : exit_failure;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "bayeslight: error: out of memory\n");
