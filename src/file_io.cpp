@@ -13,6 +13,9 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
+#include <poll.h>
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <thread>
 #include <unistd.h>
@@ -88,25 +91,71 @@ std::string read_file(const std::string& path) {
 static int (*g_fifo_wait_check)() = nullptr;
 void set_fifo_wait_check(int (*signal_count)()) { g_fifo_wait_check = signal_count; }
 
+// Whether a signal arrived since the count was signals_before (the wait for a FIFO's reader ends on one).
+static bool signal_since(int signals_before) {
+  return g_fifo_wait_check && g_fifo_wait_check() != signals_before;
+}
+
+// Writes all n bytes to a FIFO opened non-blocking: while the pipe is full (its reader holds it open without
+// reading yet), polls every 10 ms; a signal arriving meanwhile ends the wait (returns EINTR and sets interrupted).
+static int write_all_fifo(int fd, const char* data, size_t n, int signals_before, bool& interrupted) {
+  while (n > 0) {
+    ssize_t k = ::write(fd, data, n);
+    if (k < 0) {
+      if (errno == EINTR) continue;
+      if (errno != EAGAIN && errno != EWOULDBLOCK) return errno;
+      if (signal_since(signals_before)) {
+        interrupted = true;
+        return EINTR;
+      }
+      pollfd p{fd, POLLOUT, 0};
+      (void)::poll(&p, 1, 10);
+      continue;
+    }
+    data += k;
+    n -= static_cast<size_t>(k);
+  }
+  return 0;
+}
+
 // Writes bytes straight into an existing non-regular file (device, FIFO, socket): renaming over it would
 // replace the node itself. Errors such as ENOSPC from /dev/full are reported like any other. A FIFO is opened
-// without blocking, again every 10 ms until a process reads it: a blocking open waited for one deaf to SIGINT and
-// SIGTERM (their handlers only set a flag, and the open restarted); now the wait ends when a signal arrives.
+// and written without blocking, retried every 10 ms while no process reads it or its pipe is full: a blocking
+// open or write waited deaf to SIGINT and SIGTERM (their handlers only set a flag, and the call restarted); now
+// the wait ends when a signal arrives. A reader that closes early is a write failure (EPIPE), not a SIGPIPE that
+// kills the process without a word: SIGPIPE is blocked on this thread while it writes, and the one the failed
+// write raised is taken back.
 static void write_direct(const std::string& path, const std::string& bytes, bool fifo) {
   int fd = -1;
   const int signals_before = g_fifo_wait_check ? g_fifo_wait_check() : 0;
   for (;;) {
     fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | (fifo ? O_NONBLOCK : 0));
     if (fd >= 0 || !fifo || errno != ENXIO) break;
-    if (g_fifo_wait_check && g_fifo_wait_check() != signals_before)
+    if (signal_since(signals_before))
       throw write_failure(path, "interrupted while waiting for a process to read this FIFO");
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   if (fd < 0) throw write_failure(path, reason(errno));
-  if (fifo) ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
-  int err = write_all(fd, bytes.data(), bytes.size());
+  sigset_t pipe_signal, old_mask, pending;
+  sigemptyset(&pipe_signal);
+  sigaddset(&pipe_signal, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe_signal, &old_mask);
+  sigemptyset(&pending);
+  sigpending(&pending);
+  const bool pipe_pending_before = sigismember(&pending, SIGPIPE) == 1;
+  bool interrupted = false;
+  int err = fifo ? write_all_fifo(fd, bytes.data(), bytes.size(), signals_before, interrupted)
+                 : write_all(fd, bytes.data(), bytes.size());
+  if (err == EPIPE && !pipe_pending_before) {
+    const timespec now{0, 0};
+    while (sigtimedwait(&pipe_signal, nullptr, &now) < 0 && errno == EINTR) {
+    }
+  }
+  pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
   int cerr = close_checked(fd);
   if (err == 0) err = cerr;
+  if (interrupted) throw write_failure(path, "interrupted while waiting for the process reading this FIFO to take the rest");
+  if (err == EPIPE) throw write_failure(path, "the process reading it closed it before the end (broken pipe)");
   if (err != 0) throw write_failure(path, reason(err));
 }
 

@@ -576,6 +576,46 @@ TEST_CASE("an output FIFO waits for its reader until a signal ends the wait; one
   CHECK(bytes.rfind("PF\n", 0) == 0);
 }
 
+// Runs cmd (a shell command that ends by echoing a status) and returns that status.
+static int shell_status(const std::string& cmd) {
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p);
+  char buf[64] = {0};
+  bool got = fgets(buf, sizeof buf, p) != nullptr;
+  pclose(p);
+  REQUIRE(got);
+  return std::atoi(buf);
+}
+
+TEST_CASE("a FIFO output whose reader closes early or stops reading is a reported failure, never a silent death",
+          "[cli]") {
+  // A 3 MB image: more than a pipe holds. Before, a reader that closed early killed the process with SIGPIPE (141,
+  // no message), and a reader that held the FIFO open without reading kept the write blocked, deaf to SIGTERM.
+  tiny_scene s;
+  const std::string fifo = s.dir / "out.pfm";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  const std::string render = std::string(BAYESLIGHT_BINARY) + " render " + s.json +
+                             " --quiet --spp 1 --width 512 --height 512 -o " + (s.dir / "a.pfm") + " -o " + fifo +
+                             " 2>" + (s.dir / "err.txt");
+  int status = shell_status("( " + render + " & pid=$!; head -c 100 " + fifo + " >/dev/null; wait $pid; echo $? )");
+  std::string err = read_text(s.dir / "err.txt");
+  INFO(err);
+  CHECK(status == 1);
+  CHECK(err.find("cannot write " + fifo + ": the process reading it closed it before the end (broken pipe)") !=
+        std::string::npos);
+  CHECK(std::filesystem::exists(s.dir / "a.pfm"));
+  // A reader that opens the FIFO and sleeps: SIGTERM ends the blocked write (143), well before the reader's 20 s.
+  auto t0 = std::chrono::steady_clock::now();
+  status = shell_status("( (exec 3<" + fifo + "; sleep 20) & reader=$!; " + render +
+                        " & pid=$!; sleep 2; kill -TERM $pid; wait $pid; s=$?; kill $reader; echo $s )");
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  err = read_text(s.dir / "err.txt");
+  INFO(err);
+  CHECK(status == 143);
+  CHECK(err.find("interrupted while waiting for the process reading this FIFO to take the rest") != std::string::npos);
+  CHECK(seconds < 15);
+}
+
 TEST_CASE("inputs that are not regular files are refused, never read", "[cli]") {
   // A FIFO would block the read forever, a device such as /dev/urandom never ends.
   tiny_scene s;
