@@ -67,6 +67,7 @@ struct render_options {
   std::string resume;
   int stop_after_passes = -1;  // testing aid: raise SIGINT after this many passes (0: while the render sets up)
   int kill_after_passes = 0;  // testing aid: raise SIGKILL right after the checkpoint of this pass
+  std::vector<std::pair<std::string, std::string>> given;  // options given on the command line: (name, help group)
 };
 
 // Options of `diff`.
@@ -91,6 +92,7 @@ constexpr long long max_pixels = 1ll << 28;
 void check_output_path(const std::string& path) {
   fs::path p(path);
   fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (fs::is_symlink(fs::symlink_status(p))) dir = fs::path(output_target(path)).parent_path();  // where it points
   std::error_code ec;
   if (fs::is_directory(p, ec)) throw output_error("cannot write " + path + ": is a directory");
   if (!fs::is_directory(dir, ec)) throw output_error("cannot write " + path + ": directory " + dir.string() + " does not exist");
@@ -164,6 +166,42 @@ image_data load_reference(const std::string& path, const render_params& params) 
   return read_reference(path, params.width, params.height);
 }
 
+// Options that only some samplers (or some other option) use: given where they cannot apply, they are named in a
+// warning (they change nothing, and a user comparing ablations should know). What each applies to: the groups of
+// region and Bayesian options, and a few by name.
+const char* const region_group = "Regions and light cuts (bound, bayes)";
+const char* const bayes_group = "Bayesian sampler (bayes): prior strengths and ablations";
+
+// What option `name` (of group `group`) applies to, when a render with sampler `kind` and options o does not use
+// it; empty when it does.
+std::string unused_because(const std::string& name, const std::string& group, sampler_kind kind,
+                           const render_options& o) {
+  const bool bayes = kind == sampler_kind::bayes, bound = kind == sampler_kind::bound;
+  const bool adaptive = bayes || kind == sampler_kind::donikian;
+  if (name == "--cut-members" || group == bayes_group) return bayes ? "" : "bayes only";
+  if (group == region_group) return bayes || bound ? "" : "bound and bayes only";
+  if (name == "--pass-weighting") return adaptive ? "" : "bayes and donikian only";
+  if (name == "--frame-decay") return o.frames > 1 && adaptive ? "" : "with --frames and bayes or donikian only";
+  if (name == "--checkpoint-every") return o.checkpoint.empty() ? "with --checkpoint only" : "";
+  return "";
+}
+
+// Warns about the options given that no render of `kinds` uses, each with what it applies to.
+void warn_unused_options(const render_options& o, const std::vector<sampler_kind>& kinds) {
+  std::string unused;
+  for (const auto& [name, group] : o.given) {
+    std::string why;
+    for (sampler_kind k : kinds) {
+      why = unused_because(name, group, k, o);
+      if (why.empty()) break;
+    }
+    if (!why.empty()) unused += (unused.empty() ? "" : ", ") + name + " (" + why + ")";
+  }
+  if (!unused.empty())
+    std::fprintf(stderr, "bayeslight: warning: options that change nothing in this run are ignored: %s\n",
+                 unused.c_str());
+}
+
 int run_render(const render_options& o) {
   install_interrupt_handlers();  // (a signal while the scene loads ends the command at once)
   sampler_kind kind;
@@ -194,6 +232,7 @@ int run_render(const render_options& o) {
   }
   if (o.frames > 1 && (!o.checkpoint.empty() || !o.resume.empty()))
     throw usage_error("--checkpoint and --resume are not supported with --frames");
+  warn_unused_options(o, {kind});
   for (const std::string& out : outputs) check_output_path(frame_path(out, 0, animated));
   if (!o.log.empty()) check_output_path(frame_path(o.log, 0, animated));
   if (!o.checkpoint.empty()) check_output_path(o.checkpoint);
@@ -268,7 +307,8 @@ int run_render(const render_options& o) {
       // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
       if (measured != reference_key && !r.log.empty()) {
         for (pass_record& p : r.log) p.has_error = false;
-        std::fprintf(stderr,
+        if (!o.log.empty())  // (said where a log is written)
+          std::fprintf(stderr,
                      "%s: warning: its %d passes were %s; their rows of the log have no error values\n",
                      o.resume.c_str(), r.passes,
                      measured == 0        ? "rendered without --reference"
@@ -358,6 +398,21 @@ const CLI::Validator finite_number(
 const CLI::Validator file_name(
     [](std::string& text) -> std::string { return text.empty() ? "an empty file name" : std::string(); }, "");
 
+// Integers on the command line are decimal: CLI11 reads "064" as octal 52 and "0x10" as hex, so that a zero-padded
+// --spp silently rendered another count. Leading zeros are dropped ("064" is 64); a sign other than '-' (which
+// the ranges then refuse), a base prefix, spaces or a fraction are refused.
+const CLI::Validator decimal_integer(
+    [](std::string& text) -> std::string {
+      size_t digits = text.size() > 1 && text[0] == '-' ? 1 : 0;
+      if (digits == text.size() ||
+          text.find_first_not_of("0123456789", digits) != std::string::npos)
+        return "Value " + text + " is not a decimal integer";
+      size_t first = text.find_first_not_of('0', digits);
+      text.erase(digits, (first == std::string::npos ? text.size() - 1 : first) - digits);
+      return {};
+    },
+    "");
+
 // The options `render` and `compare` share: spp or time, size, depth, threads, seed, quiet, sampler options.
 void add_render_options(CLI::App* r, render_options& o) {
   auto* spp = r->add_option("--spp", o.spp, "Samples per pixel (default: the scene's render.spp)")
@@ -383,9 +438,9 @@ void add_render_options(CLI::App* r, render_options& o) {
         o.seed = uint64_t(v), o.has_seed = true;
       },
       "Random seed, 0 to 2^64 - 1 (default: the scene's render.seed)");
-  r->add_option("--width", o.width, "Image width in pixels (default: the scene's image.width)")
+  r->add_option("--width", o.width, "Image width in pixels (default: the scene's image.width; at most 2^28 pixels in all)")
       ->check(CLI::Range(1ll, max_side));
-  r->add_option("--height", o.height, "Image height in pixels (default: the scene's image.height)")
+  r->add_option("--height", o.height, "Image height in pixels (default: the scene's image.height; at most 2^28 pixels in all)")
       ->check(CLI::Range(1ll, max_side));
   r->add_flag("--quiet", o.quiet, "No progress bar or summary");
   r->add_option("--pass-weighting", o.pass_weighting,
@@ -397,7 +452,7 @@ void add_render_options(CLI::App* r, render_options& o) {
               "Independent random light choices, light points and BSDF directions at the first hit (default: "
               "stratified over each pixel's samples, or over each pass's for the adaptive samplers)");
   // Regions, cuts and the ablation switches of the adaptive samplers.
-  const char* grp = "Regions and light cuts (bound, bayes)";
+  const char* grp = region_group;
   r->add_option("--grid", o.regions.grid, "Region cells along the shortest axis of the scene bounds (default 64)")
       ->check(CLI::Range(1, 100000))->group(grp);
   r->add_option("--max-cut", o.regions.max_cut, "Light clusters per region (default 64, at most 1024)")
@@ -418,13 +473,14 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "Path vertices up to this depth use fine regions, deeper ones coarse regions (default 1)")
       ->check(CLI::Range(1, 1000))->group(grp);
   r->add_option("--region-min-samples", o.regions.min_samples,
-                "NEE samples a fine cell asks for before it gets its own region (default 16)")
+                "NEE samples a fine cell asks for before it gets its own region (default 16; the cells that "
+                "pixel-centre camera rays reach get theirs before the first pass)")
       ->check(CLI::Range(1, 1 << 30))->group(grp);
   r->add_option("--region-budget", o.regions.max_pairs,
                 "Most (region, cluster) pairs before coarser regions serve (default 1572864, at most 2^29)")
       // Pair offsets are int: fine and coarse pairs (each up to the budget) must stay below 2^31.
       ->check(CLI::Range(int64_t(1), int64_t(1) << 29))->group(grp);
-  const char* bg = "Bayesian sampler (bayes): prior strengths and ablations";
+  const char* bg = bayes_group;
   r->add_option("--bayes-pmf", o.bayes_pmf, "second-moment (the paper) or mean (ablation: PMF from the mean only)")
       ->check(CLI::IsMember({"second-moment", "mean"}))->group(bg);
   r->add_option("--bayes-prior", o.bayes_prior,
@@ -457,8 +513,8 @@ void add_render_options(CLI::App* r, render_options& o) {
   // ceiling of the fold, max_pair_weight, so that the PMF ignored the bound and p0 alike.)
   r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (1e-6 to 1e6, default 1)")
       ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
-  r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (> 1, default 2)")
-      ->check(CLI::Range(1.000001, 1e9).description("FLOAT in (1 - 1e9]"))->check(finite_number)->group(bg);
+  r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (1.000001 to 1e9, default 2)")
+      ->check(CLI::Range(1.000001, 1e9).description("FLOAT in [1.000001 - 1e9]"))->check(finite_number)->group(bg);
   r->add_option("--bayes-oracle", o.bayes.oracle_spp,
                 "Oracle mode: learn for this many spp first (own seed, not timed), then freeze the statistics")
       ->check(CLI::Range(0, 1 << 30))->group(bg);
@@ -532,6 +588,7 @@ int run_profile_command(const render_options& o) {
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
+  warn_unused_options(o, {kind});
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
   params.progress = false;
@@ -589,6 +646,7 @@ int run_compare_command(const compare_options& o) {
   if ((o.render.spp > 0) == (o.render.time > 0)) throw usage_error("compare needs exactly one of --time and --spp");
   if (o.render.frames > 0 || !o.render.checkpoint.empty() || !o.render.resume.empty())
     throw usage_error("--frames, --checkpoint and --resume are options of render, not of compare");
+  warn_unused_options(o.render, cp.samplers);
   scene_desc desc = load_scene_desc(o.render.scene);
   cp.render = resolve_params(o.render, desc, cp.samplers[0]);
   cp.runs = o.runs;
@@ -632,8 +690,17 @@ int run_cli(int argc, char** argv) {
                          "Run with --help for more information.\n", first.c_str());
     return exit_usage;
   }
+  for (CLI::App* command : app.get_subcommands({}))
+    for (CLI::Option* opt : command->get_options())
+      if (opt->get_type_name().rfind("INT", 0) == 0) opt->transform(decimal_integer);
   try {
     app.parse(argc, argv);
+    // The options given, with their help groups (what they apply to), for warn_unused_options.
+    for (auto [command, opts] : {std::pair{"render", &ro}, std::pair{"compare", &copt.render}, std::pair{"profile", &popt}})
+      if (app.got_subcommand(command))
+        for (CLI::Option* opt : app.get_subcommand(command)->get_options())
+          if (opt->count() > 0 && !opt->get_lnames().empty())
+            opts->given.emplace_back("--" + opt->get_lnames()[0], opt->get_group());
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {

@@ -178,16 +178,33 @@ static int create_temporary(const std::string& target, std::string& tmp_path) {
   return -1;
 }
 
-// The file a symlink at path finally names, so that the rename replaces the target and keeps the link; path
-// itself when it is no symlink or cannot be resolved.
+// The file a write to path creates or replaces: path with its symbolic links followed, the last ones too when
+// their target does not exist yet (a write through a dangling link creates its target, as a shell redirection
+// does), "." and ".." resolved. Links that loop are left as they are after 40 steps (the write then fails).
+static std::filesystem::path write_target(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec);
+  if (ec) return fs::path(path).lexically_normal();
+  for (int hops = 0; hops < 40; hops++) {
+    p = fs::weakly_canonical(p, ec);  // links in the existing part (a last one that resolves, too)
+    if (ec) return fs::path(path).lexically_normal();
+    if (!fs::is_symlink(fs::symlink_status(p, ec))) return p;
+    fs::path to = fs::read_symlink(p, ec);  // a dangling link: where it points
+    if (ec) return p;
+    p = to.is_absolute() ? to : p.parent_path() / to;
+  }
+  return p;
+}
+
+std::string output_target(const std::string& path) { return write_target(path).string(); }
+
+// The file a symlink at path finally names (also one that does not exist yet), so that the rename replaces or
+// creates the target and keeps the link; path itself when it is no symlink.
 static std::string rename_target(const std::string& path) {
   struct stat lst {};
   if (::lstat(path.c_str(), &lst) != 0 || !S_ISLNK(lst.st_mode)) return path;
-  char* real = ::realpath(path.c_str(), nullptr);
-  if (!real) return path;
-  std::string resolved = real;
-  std::free(real);
-  return resolved;
+  return output_target(path);
 }
 
 void write_file_atomic(const std::string& path, const std::string& bytes) {
@@ -216,13 +233,7 @@ void write_file_atomic(const std::string& path, const std::string& bytes) {
   }
 }
 
-bool same_file(const std::string& a, const std::string& b) {
-  namespace fs = std::filesystem;
-  std::error_code ea, eb;
-  fs::path pa = fs::weakly_canonical(fs::absolute(a), ea), pb = fs::weakly_canonical(fs::absolute(b), eb);
-  if (ea || eb) return fs::path(a).lexically_normal() == fs::path(b).lexically_normal();
-  return pa == pb;
-}
+bool same_file(const std::string& a, const std::string& b) { return write_target(a) == write_target(b); }
 
 void check_distinct_outputs(const std::vector<std::pair<std::string, std::string>>& outputs,
                             const std::vector<std::pair<std::string, std::string>>& inputs) {

@@ -16,8 +16,8 @@ void require_regular_file(const std::string& path);
 std::string read_file(const std::string& path);
 
 // Replaces the file at path with bytes: writes a temporary ".NAME.tmp.<pid>.<n>" in the same directory,
-// checks every write, fsyncs and closes it, then renames it over path. A symlink to a regular file is kept and
-// its target replaced. Throws output_error("cannot write PATH: reason") on any failure.
+// checks every write, fsyncs and closes it, then renames it over path. A symlink is kept and its target
+// replaced (or created, when it does not exist yet). Throws output_error("cannot write PATH: reason") on any failure.
 void write_file_atomic(const std::string& path, const std::string& bytes);
 // An existing FIFO given as an output waits for a process to read it (as any writer of a FIFO does), polling this
 // function meanwhile (a count of signals received): when it changes during the wait, a signal arrived and the wait
@@ -25,7 +25,10 @@ void write_file_atomic(const std::string& path, const std::string& bytes);
 // the wait. The render installs it with its signal handlers; without it the wait is not interruptible from here.
 void set_fifo_wait_check(int (*signal_count)());
 
-// The same file, whether or not it exists yet (symbolic links and "." / ".." resolved).
+// The file a write to path creates or replaces: symbolic links followed (a dangling one to the file it names,
+// which the write creates), "." and ".." resolved, absolute.
+std::string output_target(const std::string& path);
+// The same file, whether or not it exists yet (symbolic links, dangling ones too, and "." / ".." resolved).
 bool same_file(const std::string& a, const std::string& b);
 // Refuses (usage_error, exit 2, before any work) outputs that would overwrite one of the inputs or one another.
 // Files are (path, role) pairs; the one overlap allowed is a checkpoint (output role "checkpoint") resumed from

@@ -166,6 +166,11 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --spp 0", "--spp"},
       {"render " + s.json + " --spp -3", "--spp"},
       {"render " + s.json + " --spp abc", "--spp"},
+      // Integers are decimal (CLI11 alone read 0x10 as hex, "064" as octal 52, and took "+5").
+      {"render " + s.json + " --spp 0x10", "--spp: Value 0x10 is not a decimal integer"},
+      {"render " + s.json + " --spp +5", "--spp: Value +5 is not a decimal integer"},
+      {"render " + s.json + " --width 1.5", "--width: Value 1.5 is not a decimal integer"},
+      {"render " + s.json + " --grid 0b11", "--grid: Value 0b11 is not a decimal integer"},
       {"render " + s.json + " --spp 4 --time 1", "--time"},
       {"render " + s.json + " --threads 0", "--threads"},
       {"render " + s.json + " --max-depth 0", "--max-depth"},
@@ -616,6 +621,79 @@ TEST_CASE("a FIFO output whose reader closes early or stops reading is a reporte
   CHECK(seconds < 15);
 }
 
+TEST_CASE("integers with leading zeros are decimal", "[cli]") {
+  // CLI11 read "010" as octal 8: a zero-padded --spp rendered fewer samples than asked, silently.
+  tiny_scene s;
+  auto r = run_bayeslight("render " + s.json + " --quiet --spp 010 --width 010 --height 006 --sampler uniform -o " +
+                          (s.dir / "a.pfm") + " --log " + (s.dir / "log.csv"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  std::string log = read_text(s.dir / "log.csv");
+  size_t last = log.rfind('\n', log.size() - 2) + 1;
+  CHECK(log.substr(last, log.find(',', log.find(',', last) + 1) + 4 - last) == "uniform,9,10,");  // 8 passes of 1 spp, then 2
+  CHECK(read_image(s.dir / "a.pfm").width == 10);
+  r = run_bayeslight("render " + s.json + " --quiet --spp 10 --width 10 --height 6 --sampler uniform -o " +
+                     (s.dir / "b.pfm"));
+  REQUIRE(r.status == 0);
+  CHECK(read_text(s.dir / "a.pfm") == read_text(s.dir / "b.pfm"));
+}
+
+TEST_CASE("options that change nothing in a run are named in a warning", "[cli]") {
+  // Before, --grid or --bayes-* with --sampler uniform (or --checkpoint-every without --checkpoint) were accepted
+  // without a word: an ablation run with the wrong sampler looked like a measurement.
+  tiny_scene s;
+  const std::string base = "render " + s.json + " --spp 2 -o " + (s.dir / "a.pfm");
+  auto r = run_bayeslight(base + " --sampler uniform --grid 3 --bayes-no-cv --pass-weighting 2 --checkpoint-every 5");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("warning: options that change nothing in this run are ignored: --checkpoint-every (with "
+                      "--checkpoint only), --pass-weighting (bayes and donikian only), --grid (bound and bayes only), "
+                      "--bayes-no-cv (bayes only)\n") != std::string::npos);
+  r = run_bayeslight(base + " --sampler bound --grid 3 --cut-members 4 --bayes-c 1 --quiet");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("ignored: --cut-members (bayes only), --bayes-c (bayes only)\n") != std::string::npos);
+  // Where they apply, no warning; compare warns only about options no sampler of its list uses.
+  r = run_bayeslight(base + " --sampler bayes --grid 3 --cut-members 4 --bayes-c 1 --pass-weighting 2 --quiet");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("warning") == std::string::npos);
+  REQUIRE(run_bayeslight(base + " --quiet").status == 0);
+  for (const std::string& samplers : {"uniform,bayes", "uniform,power"}) {
+    r = run_bayeslight("compare " + s.json + " --quiet --spp 1 --samplers " + samplers + " --bayes-c 1 --reference " +
+                       (s.dir / "a.pfm") + " --out " + (s.dir / "cmp"));
+    INFO(samplers << "\n" << r.output);
+    CHECK(r.status == 0);
+    CHECK((r.output.find("ignored: --bayes-c (bayes only)") != std::string::npos) == (samplers == "uniform,power"));
+  }
+}
+
+TEST_CASE("an output through a dangling symlink is the file the link names", "[cli]") {
+  // A --log link to the image's name, not yet written, was not seen as the same file: the log then overwrote the
+  // image through it (exit 0). A dangling link is followed now, as a shell redirection does.
+  tiny_scene s;
+  std::filesystem::create_symlink("img.pfm", s.dir / "log.csv");
+  auto r = run_bayeslight("render " + s.json + " --quiet --spp 1 -o " + (s.dir / "img.pfm") + " --log " +
+                          (s.dir / "log.csv"));
+  INFO(r.output);
+  CHECK(r.status == 2);
+  CHECK(r.output.find("log " + (s.dir / "log.csv") + " is also the output " + (s.dir / "img.pfm")) !=
+        std::string::npos);
+  CHECK(!exists(s.dir / "img.pfm"));
+  // Written through: the link stays and its target is created; one into a missing directory is refused up front.
+  std::filesystem::create_symlink("new.pfm", s.dir / "link.pfm");
+  std::filesystem::create_symlink("nodir/x.pfm", s.dir / "bad.pfm");
+  r = run_bayeslight("render " + s.json + " --quiet --spp 1 -o " + (s.dir / "link.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(std::filesystem::is_symlink(s.dir / "link.pfm"));
+  CHECK(read_text(s.dir / "new.pfm").rfind("PF\n", 0) == 0);
+  r = run_bayeslight("render " + s.json + " --quiet --spp 1 -o " + (s.dir / "bad.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("nodir does not exist") != std::string::npos);
+}
+
 TEST_CASE("inputs that are not regular files are refused, never read", "[cli]") {
   // A FIFO would block the read forever, a device such as /dev/urandom never ends.
   tiny_scene s;
@@ -892,6 +970,12 @@ TEST_CASE("a resumed log keeps errors only against the reference it is measured 
       CHECK(got.back() == whole.back());
     }
   }
+  // Without --log the rows are not written: no warning about them.
+  REQUIRE(run_bayeslight(base + " --spp 4 --checkpoint " + ck + " --reference " + ref_a).status == 0);
+  auto r = run_bayeslight("render " + d.json + " --quiet --sampler bayes -o " + (d.dir / "a.pfm") + " --spp 8 --resume " + ck);
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("warning") == std::string::npos);
 }
 
 TEST_CASE("a signal while the render sets up keeps the checkpoint and log already there", "[cli]") {
