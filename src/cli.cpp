@@ -30,6 +30,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 
@@ -95,6 +96,9 @@ void check_output_path(const std::string& path) {
   if (fs::is_symlink(fs::symlink_status(p))) dir = fs::path(output_target(path)).parent_path();  // where it points
   std::error_code ec;
   if (fs::is_directory(p, ec)) throw output_error("cannot write " + path + ": is a directory");
+  // An existing FIFO or device (/dev/stdout, /dev/null) is written in place: its directory need not be writable.
+  fs::file_status st = fs::status(p, ec);
+  if (!ec && fs::exists(st) && !fs::is_regular_file(st)) return;
   if (!fs::is_directory(dir, ec)) throw output_error("cannot write " + path + ": directory " + dir.string() + " does not exist");
   if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write " + path + ": directory " + dir.string() + " is not writable");
 }
@@ -346,23 +350,29 @@ int run_render(const render_options& o) {
 
   if (int status = interrupted_before_render()) return status;
   bool interrupted = false;
+  output_failures failures;  // every output is tried (and every frame rendered) whatever failed before it
   render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
     std::vector<std::string> files;
-    for (const std::string& out : outputs) files.push_back(frame_path(out, frame, animated));
     if (result.spp > 0) {
       image_data img = film_image(result);
-      for (const std::string& f : files) write_image(f, img);
+      for (const std::string& out : outputs) {
+        std::string f = frame_path(out, frame, animated);
+        if (failures.attempt([&] { write_image(f, img); })) files.push_back(f);
+      }
     }
     // (Nor a log without a pass: a file already there is kept, as the image is.)
     if (!o.log.empty() && result.passes > 0)
-      write_file_atomic(frame_path(o.log, frame, animated), pass_log_csv(o.sampler, result.log));
+      failures.attempt(
+          [&] { write_file_atomic(frame_path(o.log, frame, animated), pass_log_csv(o.sampler, result.log)); });
     if (!o.quiet || result.interrupted) {
       std::string prefix = params.frames > 1 ? "frame " + std::to_string(frame) + ": " : "";
       std::fprintf(stderr, "%s%s\n", prefix.c_str(), render_summary(result, files).c_str());
     }
     interrupted = result.interrupted;
   });
-  if (interrupted) {
+  failures.rethrow();  // (main exits 128 + signal when a signal came, else 1)
+  // A signal that came after the last pass (while the outputs were written) still ends the run as interrupted.
+  if (interrupted || interrupt_signal() != 0) {
     int sig = interrupt_signal();
     return 128 + (sig != 0 ? sig : SIGINT);
   }
@@ -661,6 +671,9 @@ int run_compare_command(const compare_options& o) {
 }  // namespace
 
 int run_cli(int argc, char** argv) {
+  // A reader that goes away (a pipe into head, a FIFO output's reader) makes writes fail with EPIPE, reported as
+  // write failures (stdout, outputs), instead of killing the process between outputs; stderr's messages are lost.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"bayeslight — deterministic path tracer with Bayesian light selection for NEE"};
   app.require_subcommand(1);
   app.footer(
@@ -710,10 +723,16 @@ int run_cli(int argc, char** argv) {
     return exit_usage;
   }
   try {
-    if (app.got_subcommand("render")) return run_render(ro);
-    if (app.got_subcommand("diff")) return run_diff(dopt);
-    if (app.got_subcommand("compare")) return run_compare_command(copt);
-    if (app.got_subcommand("profile")) return run_profile_command(popt);
+    int status = exit_usage;
+    if (app.got_subcommand("render")) status = run_render(ro);
+    else if (app.got_subcommand("diff")) status = run_diff(dopt);
+    else if (app.got_subcommand("compare")) status = run_compare_command(copt);
+    else if (app.got_subcommand("profile")) status = run_profile_command(popt);
+    // What diff and profile print is their output: a full disk or a closed stdout is a write failure, not exit 0.
+    errno = 0;
+    if ((std::fflush(stdout) != 0 || std::ferror(stdout)) && status == exit_ok)
+      throw output_error(std::string("cannot write standard output: ") + std::strerror(errno ? errno : EIO));
+    return status;
   } catch (const usage_error& e) {
     std::fprintf(stderr, "bayeslight: error: %s\nRun with --help for more information.\n", e.what());
     return exit_usage;

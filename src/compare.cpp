@@ -260,6 +260,7 @@ static constexpr const char* plot_file = "error_vs_time.svg";
 static constexpr const char* summary_file = "summary.md";
 
 void write_comparison(const compare_data& data, const compare_params& p, const image_data& reference) {
+  output_failures failures;  // every file is tried, whatever failed before it
   for (const compare_sampler& s : data.samplers) {
     if (s.image.pixels.empty()) {
       // Interrupted before this sampler's first pass: images an earlier comparison left here would sit beside a
@@ -269,12 +270,13 @@ void write_comparison(const compare_data& data, const compare_params& p, const i
       fs::remove(error_file(p, s.kind), ec);
       continue;
     }
-    write_image(image_file(p, s.kind), s.image);
-    write_error_image(error_file(p, s.kind), s.image, reference, p.error_image);
+    failures.attempt([&] { write_image(image_file(p, s.kind), s.image); });
+    failures.attempt([&] { write_error_image(error_file(p, s.kind), s.image, reference, p.error_image); });
   }
-  write_file_atomic(out_path(p, curves_file), comparison_csv(data));
-  write_file_atomic(out_path(p, plot_file), comparison_svg(data, p));
-  write_file_atomic(out_path(p, summary_file), comparison_summary(data, p));
+  failures.attempt([&] { write_file_atomic(out_path(p, curves_file), comparison_csv(data)); });
+  failures.attempt([&] { write_file_atomic(out_path(p, plot_file), comparison_svg(data, p)); });
+  failures.attempt([&] { write_file_atomic(out_path(p, summary_file), comparison_summary(data, p)); });
+  failures.rethrow();
 }
 
 // Creates the output directory when missing, with any missing parents (as mkdir -p); throws output_error when it
@@ -327,11 +329,13 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
     return 128 + data.signal;
   }
   write_comparison(data, params, reference);
+  // (A signal that came after the last render, while the files were written, ends the command as interrupted.)
+  const int sig = data.signal != 0 ? data.signal : interrupt_signal();
   if (!params.quiet || data.signal != 0)
     std::fprintf(stderr, "compare: %s -> %s (summary.md, curves.csv, error_vs_time.svg, <sampler>.exr, "
                          "<sampler>_error.png)\n",
                  data.signal != 0 ? "interrupted; wrote the passes completed so far" : "done", params.out_dir.c_str());
-  return data.signal != 0 ? 128 + data.signal : exit_ok;
+  return sig != 0 ? 128 + sig : exit_ok;
 }
 
 }  // namespace bl

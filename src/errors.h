@@ -29,6 +29,27 @@ struct output_error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The failures of a set of outputs written one after another: each is tried and a failure kept, so that one
+// output that cannot be written (a full disk, a FIFO's reader gone) does not lose the outputs after it.
+struct output_failures {
+  std::string messages;  // one per line
+  // Runs write(); an output_error it throws is kept (false) instead of ending the caller.
+  template <class F>
+  bool attempt(F&& write) {
+    try {
+      write();
+      return true;
+    } catch (const output_error& e) {
+      messages += (messages.empty() ? "" : "\nbayeslight: error: ") + std::string(e.what());
+      return false;
+    }
+  }
+  // Throws one output_error naming every failure (each on its own line, as main prints errors), if any.
+  void rethrow() const {
+    if (!messages.empty()) throw output_error(messages);
+  }
+};
+
 // Bad command line (unknown flag, value out of range, unknown sampler name).
 struct usage_error : std::runtime_error {
   using std::runtime_error::runtime_error;

@@ -95,6 +95,9 @@ void set_fifo_wait_check(int (*signal_count)()) { g_fifo_wait_check = signal_cou
 static bool signal_since(int signals_before) {
   return g_fifo_wait_check && g_fifo_wait_check() != signals_before;
 }
+// Set once a signal has ended a wait: a later FIFO output without a reader then fails at once (one SIGINT given to
+// end a wait must not have to be given again for every checkpoint and output after it).
+static std::atomic<bool> g_fifo_wait_given_up{false};
 
 // Writes all n bytes to a FIFO opened non-blocking: while the pipe is full (its reader holds it open without
 // reading yet), polls every 10 ms; a signal arriving meanwhile ends the wait (returns EINTR and sets interrupted).
@@ -106,6 +109,7 @@ static int write_all_fifo(int fd, const char* data, size_t n, int signals_before
       if (errno != EAGAIN && errno != EWOULDBLOCK) return errno;
       if (signal_since(signals_before)) {
         interrupted = true;
+        g_fifo_wait_given_up = true;
         return EINTR;
       }
       pollfd p{fd, POLLOUT, 0};
@@ -131,8 +135,12 @@ static void write_direct(const std::string& path, const std::string& bytes, bool
   for (;;) {
     fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | (fifo ? O_NONBLOCK : 0));
     if (fd >= 0 || !fifo || errno != ENXIO) break;
-    if (signal_since(signals_before))
+    if (g_fifo_wait_given_up)
+      throw write_failure(path, "no process reads this FIFO (a signal ended an earlier wait for a reader)");
+    if (signal_since(signals_before)) {
+      g_fifo_wait_given_up = true;
       throw write_failure(path, "interrupted while waiting for a process to read this FIFO");
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   if (fd < 0) throw write_failure(path, reason(errno));

@@ -37,7 +37,10 @@ extern "C" void on_interrupt(int sig) {
     // Async-signal-safe: write(2) and _exit(2) only.
     static const char term[] = "bayeslight: interrupted (SIGTERM) while loading the scene; nothing written\n";
     static const char intr[] = "bayeslight: interrupted (SIGINT) while loading the scene; nothing written\n";
-    ssize_t ignored = sig == SIGTERM ? write(2, term, sizeof term - 1) : write(2, intr, sizeof intr - 1);
+    static const char hup[] = "bayeslight: interrupted (SIGHUP) while loading the scene; nothing written\n";
+    ssize_t ignored = sig == SIGTERM  ? write(2, term, sizeof term - 1)
+                      : sig == SIGHUP ? write(2, hup, sizeof hup - 1)
+                                      : write(2, intr, sizeof intr - 1);
     (void)ignored;
     _exit(128 + sig);
   }
@@ -420,6 +423,9 @@ void install_interrupt_handlers() {
   g_phase.store(phase_setup);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
+  // A closed terminal (SIGHUP) stops the render as SIGTERM does (image of the passes done, exit 129), unless the
+  // process was started to ignore it (nohup): that choice is kept.
+  if (std::signal(SIGHUP, SIG_IGN) != SIG_IGN) std::signal(SIGHUP, on_interrupt);
   set_fifo_wait_check(interrupt_count);  // an output FIFO's wait for its reader ends on a signal that arrives in it
   // A process started with them blocked (a launcher's mask is inherited) could not be interrupted at all; one that
   // arrived meanwhile is delivered now.
@@ -427,6 +433,7 @@ void install_interrupt_handlers() {
   sigemptyset(&s);
   sigaddset(&s, SIGINT);
   sigaddset(&s, SIGTERM);
+  sigaddset(&s, SIGHUP);
   pthread_sigmask(SIG_UNBLOCK, &s, nullptr);
 }
 int interrupt_signal() { return g_signal.load(); }
@@ -437,7 +444,7 @@ int interrupted_before_render() {
   int sig = g_signal.load();
   if (sig == 0) return 0;
   std::fprintf(stderr, "bayeslight: interrupted (%s) while loading the scene; nothing written\n",
-               sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : "signal");
+               sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : sig == SIGHUP ? "SIGHUP" : "signal");
   return 128 + sig;
 }
 

@@ -621,6 +621,85 @@ TEST_CASE("a FIFO output whose reader closes early or stops reading is a reporte
   CHECK(seconds < 15);
 }
 
+TEST_CASE("one SIGINT ends every FIFO wait, and the outputs after a failed one are still written", "[cli]") {
+  // A checkpoint FIFO without a reader: SIGINT ended its wait, but the final checkpoint waited again (a second SIGINT
+  // was needed); and the FIFO image's failure lost the outputs after it (keep.pfm, the log) though the run exited 130.
+  tiny_scene s;
+  const std::string ck = s.dir / "ck.bin", fifo = s.dir / "out.pfm";
+  REQUIRE(::mkfifo(ck.c_str(), 0600) == 0);
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  int status = shell_status(std::string("( timeout -k 1 20 ") + BAYESLIGHT_BINARY + " render " + s.json +
+                            " --quiet --spp 64 --checkpoint " + ck + " --checkpoint-every 0 -o " + fifo + " -o " +
+                            (s.dir / "keep.pfm") + " --log " + (s.dir / "l.csv") + " 2>" + (s.dir / "err.txt") +
+                            " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo $? )");
+  std::string err = read_text(s.dir / "err.txt");
+  INFO(err);
+  CHECK(status == 130);
+  CHECK(err.find("warning: cannot write " + ck + ": interrupted while waiting for a process to read this FIFO") !=
+        std::string::npos);
+  CHECK(err.find("cannot write " + fifo + ": no process reads this FIFO (a signal ended an earlier wait") !=
+        std::string::npos);
+  CHECK(read_text(s.dir / "keep.pfm").rfind("PF\n", 0) == 0);
+  CHECK(read_text(s.dir / "l.csv").rfind("sampler,pass", 0) == 0);
+  // compare: a file that cannot be written (curves.csv on a full disk) loses none of the others.
+  REQUIRE(run_bayeslight("render " + s.json + " --quiet --spp 4 -o " + (s.dir / "ref.pfm")).status == 0);
+  std::filesystem::create_directory(s.dir / "cmp");
+  std::filesystem::create_symlink("/dev/full", s.dir / "cmp/curves.csv");
+  auto r = run_bayeslight("compare " + s.json + " --quiet --spp 2 --samplers uniform,power --reference " +
+                          (s.dir / "ref.pfm") + " --out " + (s.dir / "cmp"));
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("cannot write " + (s.dir / "cmp/curves.csv")) != std::string::npos);
+  for (const char* f : {"summary.md", "error_vs_time.svg", "uniform.exr", "power.exr", "power_error.png"})
+    CHECK(exists(s.dir / (std::string("cmp/") + f)));
+}
+
+TEST_CASE("standard output and error that cannot be written neither pass silently nor kill the run", "[cli]") {
+  tiny_scene s;
+  REQUIRE(run_bayeslight("render " + s.json + " --quiet --spp 2 -o " + (s.dir / "a.pfm")).status == 0);
+  // diff's report into a full disk (or a closed stdout): exit 1 and a message, where it exited 0 without a word.
+  for (const char* out : {">/dev/full", ">&-"}) {
+    std::string cmd = std::string("( ") + BAYESLIGHT_BINARY + " diff " + (s.dir / "a.pfm") + " " + (s.dir / "a.pfm") +
+                      " " + out + " 2>" + (s.dir / "err.txt") + "; echo $? ) 2>/dev/null";
+    FILE* p = popen(cmd.c_str(), "r");
+    REQUIRE(p);
+    char buf[64] = {0};
+    bool got = fgets(buf, sizeof buf, p) != nullptr;
+    pclose(p);
+    std::string err = read_text(s.dir / "err.txt");
+    INFO(out << "\n" << err);
+    REQUIRE(got);
+    CHECK(std::atoi(buf) == 1);
+    CHECK(err.find("bayeslight: error: cannot write standard output") != std::string::npos);
+  }
+  // stderr a pipe whose reader is gone: the warning and the frame summaries fail (EPIPE), the frames are written.
+  // Before, SIGPIPE killed the process at its first message (no frame written).
+  int fds[2];
+  REQUIRE(::pipe(fds) == 0);
+  ::close(fds[0]);
+  std::vector<std::string> args = {BAYESLIGHT_BINARY, "render", s.json, "--frames", "3", "--spp", "2",
+                                   "-o", s.dir / "f_%d.pfm"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = ::fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    ::dup2(fds[1], 2);
+    int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::signal(SIGPIPE, SIG_DFL);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  ::close(fds[1]);
+  int st = 0;
+  REQUIRE(::waitpid(pid, &st, 0) == pid);
+  CHECK(WIFEXITED(st));
+  CHECK((WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st)) == 0);
+  for (const char* f : {"f_0.pfm", "f_1.pfm", "f_2.pfm"}) CHECK(exists(s.dir / f));
+}
+
 TEST_CASE("integers with leading zeros are decimal", "[cli]") {
   // CLI11 read "010" as octal 8: a zero-padded --spp rendered fewer samples than asked, silently.
   tiny_scene s;
@@ -811,7 +890,8 @@ TEST_CASE("help lists the samplers and options", "[cli]") {
 
 TEST_CASE("an interrupted render writes the completed passes and exits 130 or 143", "[cli]") {
   tiny_scene s;
-  for (const char* sig : {"INT", "TERM"}) {
+  // SIGHUP (a closed terminal) as SIGTERM: before, it killed the render with nothing written.
+  for (const char* sig : {"INT", "TERM", "HUP"}) {
     std::string out = s.dir / (std::string("int_") + sig + ".pfm"), log = s.dir / "int.csv";
     // A render far too long to finish, stopped after a second by the signal.
     std::string cmd = std::string("( ") + BAYESLIGHT_BINARY + " render " + s.json +
@@ -824,7 +904,7 @@ TEST_CASE("an interrupted render writes the completed passes and exits 130 or 14
     pclose(p);
     int status = std::atoi(buf);
     INFO(sig);
-    CHECK(status == (std::string(sig) == "INT" ? 130 : 143));
+    CHECK(status == (std::string(sig) == "INT" ? 130 : std::string(sig) == "TERM" ? 143 : 129));
     REQUIRE(exists(out));
     image_data img = read_image(out);
     CHECK(img.width == 64);
