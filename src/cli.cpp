@@ -93,8 +93,14 @@ constexpr long long max_pixels = 1ll << 28;
 void check_output_path(const std::string& path) {
   fs::path p(path);
   fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  if (fs::is_symlink(fs::symlink_status(p))) dir = fs::path(output_target(path)).parent_path();  // where it points
   std::error_code ec;
+  if (fs::is_symlink(fs::symlink_status(p, ec))) {
+    (void)fs::status(p, ec);
+    if (ec == std::errc::too_many_symbolic_link_levels) throw output_error("cannot write " + path + ": " + ec.message());
+    fs::path target = fs::path(output_target(path)).parent_path();  // where it points
+    if (!target.empty()) dir = target;
+  }
+  ec.clear();
   if (fs::is_directory(p, ec)) throw output_error("cannot write " + path + ": is a directory");
   // An existing FIFO or device (/dev/stdout, /dev/null) is written in place: its directory need not be writable.
   fs::file_status st = fs::status(p, ec);
@@ -173,7 +179,7 @@ image_data load_reference(const std::string& path, const render_params& params) 
 // Options that only some samplers (or some other option) use: given where they cannot apply, they are named in a
 // warning (they change nothing, and a user comparing ablations should know). What each applies to: the groups of
 // region and Bayesian options, and a few by name.
-const char* const region_group = "Regions and light cuts (bound, bayes)";
+const char* const region_group = "Regions and light cuts (bound, donikian, bayes)";
 const char* const bayes_group = "Bayesian sampler (bayes): prior strengths and ablations";
 
 // What option `name` (of group `group`) applies to, when a render with sampler `kind` and options o does not use
@@ -183,7 +189,8 @@ std::string unused_because(const std::string& name, const std::string& group, sa
   const bool bayes = kind == sampler_kind::bayes, bound = kind == sampler_kind::bound;
   const bool adaptive = bayes || kind == sampler_kind::donikian;
   if (name == "--cut-members" || group == bayes_group) return bayes ? "" : "bayes only";
-  if (group == region_group) return bayes || bound ? "" : "bound and bayes only";
+  // (donikian's deeper vertices use bound's regions, and its first-hit cut their --max-cut)
+  if (group == region_group) return bayes || bound || adaptive ? "" : "bound, donikian and bayes only";
   if (name == "--pass-weighting") return adaptive ? "" : "bayes and donikian only";
   if (name == "--frame-decay") return o.frames > 1 && adaptive ? "" : "with --frames and bayes or donikian only";
   if (name == "--checkpoint-every") return o.checkpoint.empty() ? "with --checkpoint only" : "";
@@ -341,7 +348,8 @@ int run_render(const render_options& o) {
       write_file_atomic(o.checkpoint, encode_checkpoint(fingerprint, reference_key, r, s));
     } catch (const output_error& e) {
       if (checkpoint_failure.empty())
-        std::fprintf(stderr, "bayeslight: warning: %s; the render goes on without it\n", e.what());
+        std::fprintf(stderr, "bayeslight: warning: %s; the render %s without it\n", e.what(),
+                     interrupt_signal() != 0 ? "stops after this pass" : "goes on");
       checkpoint_failure = e.what();
     }
     last_write = now;
@@ -374,6 +382,9 @@ int run_render(const render_options& o) {
   // A signal that came after the last pass (while the outputs were written) still ends the run as interrupted.
   if (interrupted || interrupt_signal() != 0) {
     int sig = interrupt_signal();
+    if (!interrupted)
+      std::fprintf(stderr, "bayeslight: interrupted (%s) after the last pass; every output was written\n",
+                   signal_name(sig));
     return 128 + (sig != 0 ? sig : SIGINT);
   }
   if (!checkpoint_failure.empty()) throw output_error(checkpoint_failure);  // (the image is written)
@@ -684,8 +695,8 @@ int run_cli(int argc, char** argv) {
       "  bayeslight diff out.exr ref.exr\n"
       "Each command's options: bayeslight COMMAND --help.\n"
       "Exit status: 0 success; 1 other failure (e.g. an output that cannot be written); 2 bad command line; 3 bad "
-      "input (the message names the file and line); 130/143 interrupted (SIGINT/SIGTERM), after writing the image of "
-      "the passes completed.");
+      "input (the message names the file and line); 130/143/129 interrupted (SIGINT/SIGTERM/SIGHUP), after writing the "
+      "image of the passes completed.");
   render_options ro;
   diff_options dopt;
   compare_options copt;

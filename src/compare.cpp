@@ -331,10 +331,13 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   write_comparison(data, params, reference);
   // (A signal that came after the last render, while the files were written, ends the command as interrupted.)
   const int sig = data.signal != 0 ? data.signal : interrupt_signal();
-  if (!params.quiet || data.signal != 0)
+  if (!params.quiet || sig != 0)
     std::fprintf(stderr, "compare: %s -> %s (summary.md, curves.csv, error_vs_time.svg, <sampler>.exr, "
                          "<sampler>_error.png)\n",
-                 data.signal != 0 ? "interrupted; wrote the passes completed so far" : "done", params.out_dir.c_str());
+                 data.signal != 0 ? "interrupted; wrote the passes completed so far"
+                 : sig != 0       ? "interrupted after the last render; wrote everything"
+                                  : "done",
+                 params.out_dir.c_str());
   return sig != 0 ? 128 + sig : exit_ok;
 }
 

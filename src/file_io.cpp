@@ -102,12 +102,16 @@ static std::atomic<bool> g_fifo_wait_given_up{false};
 // Writes all n bytes to a FIFO opened non-blocking: while the pipe is full (its reader holds it open without
 // reading yet), polls every 10 ms; a signal arriving meanwhile ends the wait (returns EINTR and sets interrupted).
 static int write_all_fifo(int fd, const char* data, size_t n, int signals_before, bool& interrupted) {
+  // After a signal ended an earlier wait, a reader that takes nothing for a second is given up too (one that reads
+  // keeps the write going).
+  auto progress = std::chrono::steady_clock::now();
   while (n > 0) {
     ssize_t k = ::write(fd, data, n);
     if (k < 0) {
       if (errno == EINTR) continue;
       if (errno != EAGAIN && errno != EWOULDBLOCK) return errno;
-      if (signal_since(signals_before)) {
+      if (signal_since(signals_before) ||
+          (g_fifo_wait_given_up && std::chrono::steady_clock::now() - progress > std::chrono::seconds(1))) {
         interrupted = true;
         g_fifo_wait_given_up = true;
         return EINTR;
@@ -118,6 +122,7 @@ static int write_all_fifo(int fd, const char* data, size_t n, int signals_before
     }
     data += k;
     n -= static_cast<size_t>(k);
+    progress = std::chrono::steady_clock::now();
   }
   return 0;
 }

@@ -437,14 +437,16 @@ void install_interrupt_handlers() {
   pthread_sigmask(SIG_UNBLOCK, &s, nullptr);
 }
 int interrupt_signal() { return g_signal.load(); }
+const char* signal_name(int sig) {
+  return sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : sig == SIGHUP ? "SIGHUP" : "signal";
+}
 int interrupt_count() { return g_signal_count.load(); }
 void reset_interrupt() { g_signal.store(0); }
 int interrupted_before_render() {
   g_phase.store(phase_before_render);  // until the first render sets up, a signal asks it to stop after its pass
   int sig = g_signal.load();
   if (sig == 0) return 0;
-  std::fprintf(stderr, "bayeslight: interrupted (%s) while loading the scene; nothing written\n",
-               sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : sig == SIGHUP ? "SIGHUP" : "signal");
+  std::fprintf(stderr, "bayeslight: interrupted (%s) while loading the scene; nothing written\n", signal_name(sig));
   return 128 + sig;
 }
 

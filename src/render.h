@@ -109,6 +109,8 @@ void install_interrupt_handlers();
 int interrupt_signal();
 // How many SIGINT/SIGTERM the handlers have received so far.
 int interrupt_count();
+// "SIGINT", "SIGTERM", "SIGHUP" (or "signal") for messages.
+const char* signal_name(int sig);
 // Clears a pending interrupt request (tests).
 void reset_interrupt();
 // Ends the set-up phase (see install_interrupt_handlers). A signal noted before it (not while setting up, which

@@ -67,10 +67,10 @@ std::string render_summary(const render_result& r, const std::vector<std::string
   std::snprintf(buf, sizeof buf, "; peak memory %.0f MB", double(peak_memory_bytes()) / (1 << 20));
   s += buf;
   if (st.bad_samples > 0) s += "; " + std::to_string(st.bad_samples) + " non-finite samples discarded";
-  if (r.spp > 0) {
+  if (r.spp > 0 && !outputs.empty()) {  // (none when every image output failed: their errors follow)
     s += " -> ";
     for (size_t i = 0; i < outputs.size(); i++) s += (i ? ", " : "") + outputs[i];
-  } else {
+  } else if (r.spp == 0) {
     s += "; no pass completed, no image written";
   }
   return s;

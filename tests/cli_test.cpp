@@ -628,7 +628,7 @@ TEST_CASE("one SIGINT ends every FIFO wait, and the outputs after a failed one a
   const std::string ck = s.dir / "ck.bin", fifo = s.dir / "out.pfm";
   REQUIRE(::mkfifo(ck.c_str(), 0600) == 0);
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
-  int status = shell_status(std::string("( timeout -k 1 20 ") + BAYESLIGHT_BINARY + " render " + s.json +
+  int status = shell_status(std::string("( timeout -k 10 20 ") + BAYESLIGHT_BINARY + " render " + s.json +
                             " --quiet --spp 64 --checkpoint " + ck + " --checkpoint-every 0 -o " + fifo + " -o " +
                             (s.dir / "keep.pfm") + " --log " + (s.dir / "l.csv") + " 2>" + (s.dir / "err.txt") +
                             " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo $? )");
@@ -652,6 +652,28 @@ TEST_CASE("one SIGINT ends every FIFO wait, and the outputs after a failed one a
   CHECK(r.output.find("cannot write " + (s.dir / "cmp/curves.csv")) != std::string::npos);
   for (const char* f : {"summary.md", "error_vs_time.svg", "uniform.exr", "power.exr", "power_error.png"})
     CHECK(exists(s.dir / (std::string("cmp/") + f)));
+}
+
+TEST_CASE("after a signal ended a FIFO wait, a later FIFO whose reader takes nothing is given up too", "[cli]") {
+  // f1 has no reader (SIGINT ends its wait); f2's reader holds it open and sleeps: its 196 KB image filled the pipe
+  // and waited for a second signal, so reg.pfm came only after the reader's 20 s.
+  tiny_scene s;
+  const std::string f1 = s.dir / "f1.pfm", f2 = s.dir / "f2.pfm";
+  REQUIRE(::mkfifo(f1.c_str(), 0600) == 0);
+  REQUIRE(::mkfifo(f2.c_str(), 0600) == 0);
+  auto t0 = std::chrono::steady_clock::now();
+  int status = shell_status("( (exec 3<" + f2 + "; sleep 20) & reader=$!; " + BAYESLIGHT_BINARY +
+                            " render " + s.json + " --quiet --spp 2 --width 128 --height 128 -o " + f1 + " -o " + f2 +
+                            " -o " + (s.dir / "reg.pfm") + " 2>" + (s.dir / "err.txt") +
+                            " & pid=$!; sleep 1; kill -INT $pid; wait $pid; s=$?; kill $reader; echo $s )");
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::string err = read_text(s.dir / "err.txt");
+  INFO(err);
+  CHECK(status == 130);
+  CHECK(err.find("cannot write " + f2 + ": interrupted while waiting for the process reading this FIFO") !=
+        std::string::npos);
+  CHECK(exists(s.dir / "reg.pfm"));
+  CHECK(seconds < 10);
 }
 
 TEST_CASE("standard output and error that cannot be written neither pass silently nor kill the run", "[cli]") {
@@ -726,12 +748,17 @@ TEST_CASE("options that change nothing in a run are named in a warning", "[cli]"
   INFO(r.output);
   CHECK(r.status == 0);
   CHECK(r.output.find("warning: options that change nothing in this run are ignored: --checkpoint-every (with "
-                      "--checkpoint only), --pass-weighting (bayes and donikian only), --grid (bound and bayes only), "
+                      "--checkpoint only), --pass-weighting (bayes and donikian only), --grid (bound, donikian and bayes only), "
                       "--bayes-no-cv (bayes only)\n") != std::string::npos);
   r = run_bayeslight(base + " --sampler bound --grid 3 --cut-members 4 --bayes-c 1 --quiet");
   INFO(r.output);
   CHECK(r.status == 0);
   CHECK(r.output.find("ignored: --cut-members (bayes only), --bayes-c (bayes only)\n") != std::string::npos);
+  // donikian's deeper vertices sample by bound's regions (and its first-hit cut takes --max-cut): no warning for them.
+  r = run_bayeslight(base + " --sampler donikian --grid 3 --max-cut 2 --pass-weighting 2 --cut-members 4 --quiet");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("ignored: --cut-members (bayes only)\n") != std::string::npos);
   // Where they apply, no warning; compare warns only about options no sampler of its list uses.
   r = run_bayeslight(base + " --sampler bayes --grid 3 --cut-members 4 --bayes-c 1 --pass-weighting 2 --quiet");
   INFO(r.output);
@@ -771,6 +798,13 @@ TEST_CASE("an output through a dangling symlink is the file the link names", "[c
   INFO(r.output);
   CHECK(r.status == 1);
   CHECK(r.output.find("nodir does not exist") != std::string::npos);
+  // A link that loops is named as such (not "directory  does not exist").
+  std::filesystem::create_symlink("loop.pfm", s.dir / "loop.pfm");
+  r = run_bayeslight("render " + s.json + " --quiet --spp 1 -o " + (s.dir / "loop.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("cannot write " + (s.dir / "loop.pfm") + ": Too many levels of symbolic links") !=
+        std::string::npos);
 }
 
 TEST_CASE("inputs that are not regular files are refused, never read", "[cli]") {
