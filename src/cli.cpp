@@ -522,7 +522,8 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_flag_callback("--bayes-no-regression", [&o] { o.bayes.distance_regression = false; },
                        "Ablation: no 1/d^2 distance regression (z = Y)")->group(bg);
   r->add_flag_callback("--bayes-naive", [&o] { o.bayes.prior = false; },
-                       "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method)")->group(bg);
+                       "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method: clusters it starves are "
+                       "never sampled again, so its images are biased in practice)")->group(bg);
   r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the prior-only (bound) PMF, in [0, 1] (default 0)")
       ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
   // (At most 1e6 apart from the counts: the posterior mean of 1 - p0 stays far above float's least number.)
