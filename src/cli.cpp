@@ -190,7 +190,7 @@ std::string unused_because(const std::string& name, const std::string& group, sa
   const bool adaptive = bayes || kind == sampler_kind::donikian;
   if (name == "--cut-members" || group == bayes_group) return bayes ? "" : "bayes only";
   // (donikian's deeper vertices use bound's regions, and its first-hit cut their --max-cut)
-  if (group == region_group) return bayes || bound || adaptive ? "" : "bound, donikian and bayes only";
+  if (group == region_group) return bound || adaptive ? "" : "bound, donikian and bayes only";
   if (name == "--pass-weighting") return adaptive ? "" : "bayes and donikian only";
   if (name == "--frame-decay") return o.frames > 1 && adaptive ? "" : "with --frames and bayes or donikian only";
   if (name == "--checkpoint-every") return o.checkpoint.empty() ? "with --checkpoint only" : "";

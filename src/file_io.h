@@ -23,7 +23,8 @@ void write_file_atomic(const std::string& path, const std::string& bytes);
 // function meanwhile (a count of signals received): when it changes during the wait, a signal arrived and the wait
 // gives up with a write_failure. A signal that came before (an interrupted render writing its passes) does not stop
 // the wait. The render installs it with its signal handlers; without it the wait is not interruptible from here.
-// Once a signal has ended a wait, a later FIFO output that no process reads fails at once.
+// Once a signal has ended a wait, a later FIFO output that no process reads fails at once, and one whose reader
+// takes nothing for a second fails then.
 void set_fifo_wait_check(int (*signal_count)());
 
 // The file a write to path creates or replaces: symbolic links followed (a dangling one to the file it names,
