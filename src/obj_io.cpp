@@ -50,107 +50,38 @@ static bool in_triangle(const double* x, const double* y, int a, int b, int c, i
   return cross2(x, y, a, b, q) >= 0 && cross2(x, y, b, c, q) >= 0 && cross2(x, y, c, a, q) >= 0;
 }
 
-// The reflex corners of a polygon bucketed in a uniform 2D grid over their bounding box, so that an ear test
-// looks only at the corners in the cells its triangle's box overlaps: a concave polygon of 10^5 corners tests a few
-// corners per ear instead of every reflex one (which ran out of the file's budget and fell back to overlapping fans).
-// The cells are fixed when ear clipping starts; a corner that turns reflex later (degenerate input only) is kept in
-// `late` and tested always.
-struct reflex_grid {
-  double x0 = 0, y0 = 0, fx = 0, fy = 0;  // cell of (x, y): ((x - x0) fx, (y - y0) fy), clamped
-  int g = 1;
-  std::vector<int> start, items, late;
-  int cell(double v) const { return !(v > 0) ? 0 : v >= double(g - 1) ? g - 1 : int(v); }  // (monotone in v)
-  int cell_x(double x) const { return cell((x - x0) * fx); }
-  int cell_y(double y) const { return cell((y - y0) * fy); }
-  reflex_grid(const std::vector<double>& x, const std::vector<double>& y, const std::vector<int>& corners) {
-    if (corners.empty()) return;
-    double x1 = x[size_t(corners[0])], y1 = y[size_t(corners[0])];
-    x0 = x1, y0 = y1;
-    for (int c : corners) {
-      x0 = std::min(x0, x[size_t(c)]), x1 = std::max(x1, x[size_t(c)]);
-      y0 = std::min(y0, y[size_t(c)]), y1 = std::max(y1, y[size_t(c)]);
-    }
-    // About 16 cells per corner: a polygon's corners lie along its outline, not all over its box, so the cells
-    // on the outline must be small (a 10^5-corner star: ~20 corners in a cell; at most 2048^2 cells, 16 MiB).
-    g = std::clamp(int(4 * std::sqrt(double(corners.size()))), 1, 2048);
-    fx = x1 > x0 ? g / (x1 - x0) : 0.0;
-    fy = y1 > y0 ? g / (y1 - y0) : 0.0;
-    if (!std::isfinite(fx)) fx = 0;  // (a box too thin for the division: one column of cells)
-    if (!std::isfinite(fy)) fy = 0;
-    start.assign(size_t(g) * size_t(g) + 1, 0);
-    for (int c : corners) start[size_t(cell_y(y[size_t(c)])) * size_t(g) + size_t(cell_x(x[size_t(c)])) + 1]++;
-    for (size_t i = 1; i < start.size(); i++) start[i] += start[i - 1];
-    items.resize(corners.size());
-    std::vector<int> fill(start.begin(), start.end() - 1);
-    for (int c : corners) items[size_t(fill[size_t(cell_y(y[size_t(c)])) * size_t(g) + size_t(cell_x(x[size_t(c)]))]++)] = c;
-  }
-  // Calls f(corner) for every corner that may lie in the box [xa, xb] x [ya, yb] (each once), or for every corner
-  // of `active` (the reflex corners now) when that list is shorter than the box's cells; stops when f is true.
-  template <class F>
-  bool any_in_box(double xa, double xb, double ya, double yb, const std::vector<int>& active, F&& f) const {
-    int cx0 = cell_x(xa), cx1 = cell_x(xb), cy0 = cell_y(ya), cy1 = cell_y(yb);
-    if (double(cx1 - cx0 + 1) * double(cy1 - cy0 + 1) > double(active.size())) {
-      for (int c : active)
-        if (f(c)) return true;
-      return false;
-    }
-    for (int c : late)
-      if (f(c)) return true;
-    if (items.empty()) return false;
-    for (int cy = cy0; cy <= cy1; cy++)
-      for (int cx = cx0; cx <= cx1; cx++) {
-        size_t cell = size_t(cy) * size_t(g) + size_t(cx);
-        for (int k = start[cell]; k < start[cell + 1]; k++)
-          if (f(items[size_t(k)])) return true;
-      }
-    return false;
-  }
-};
-
 // Ear clipping of a simple counter-clockwise 2D polygon into n-2 triangles of local corner indices.
-// Only reflex corners can lie inside an ear, so only they are tested (those in the grid cells of the ear's box, or
-// the reflex corners left when they are fewer). After an ear the search goes on two corners further (as earcut
-// does), so ears spread around the polygon: stepping back to the previous corner fanned from one corner, and each
-// growing fan triangle was tested against most reflex corners (a 10^5-corner star spent the file's budget).
-// When no ear is found in a full turn (self-intersecting or degenerate input) or the budget runs out, the current
-// corner is clipped anyway.
+// Only reflex corners can lie inside an ear, so only they are tested. When no ear is found in a full turn
+// (self-intersecting or degenerate input) or the budget runs out, the current corner is clipped anyway.
 static void ear_clip(const std::vector<double>& x, const std::vector<double>& y, triangulate_state& st,
                      std::vector<int>& tris) {
   int n = int(x.size());
   std::vector<int> prev(n), next(n);
-  std::vector<char> reflex(n), alive(n, 1), listed(n, 0);
-  std::vector<int> active, place(n, -1);  // the reflex corners now (place: index in active, or -1)
+  std::vector<char> reflex(n), alive(n, 1);
+  std::vector<int> reflex_list;
   for (int i = 0; i < n; i++) {
     prev[i] = (i + n - 1) % n;
     next[i] = (i + 1) % n;
     reflex[i] = cross2(x.data(), y.data(), prev[i], i, next[i]) < 0;
-    if (reflex[i]) place[i] = int(active.size()), active.push_back(i), listed[i] = 1;
+    if (reflex[i]) reflex_list.push_back(i);
   }
-  auto deactivate = [&](int v) {
-    if (place[v] < 0) return;
-    int last = active.back();
-    active[size_t(place[v])] = last;
-    place[last] = place[v];
-    active.pop_back();
-    place[v] = -1;
-  };
-  reflex_grid grid(x, y, active);
   bool out_of_budget = false;
   int remaining = n, i = 0, misses = 0;
   while (remaining > 3) {
     int a = prev[i], b = next[i];
     bool ear = false;
     if (!out_of_budget && misses <= remaining && cross2(x.data(), y.data(), a, i, b) > 0) {
-      auto inside = [&](int r) {
+      ear = true;
+      for (int r : reflex_list) {
         st.budget--;
-        if (!alive[r] || !reflex[r] || r == a || r == i || r == b) return false;
+        if (!alive[r] || !reflex[r] || r == a || r == i || r == b) continue;
         bool same_point =
             (x[r] == x[a] && y[r] == y[a]) || (x[r] == x[b] && y[r] == y[b]) || (x[r] == x[i] && y[r] == y[i]);
-        return !same_point && in_triangle(x.data(), y.data(), a, i, b, r);
-      };
-      double xa = std::min({x[a], x[i], x[b]}), xb = std::max({x[a], x[i], x[b]});
-      double ya = std::min({y[a], y[i], y[b]}), yb = std::max({y[a], y[i], y[b]});
-      ear = !grid.any_in_box(xa, xb, ya, yb, active, inside);
+        if (!same_point && in_triangle(x.data(), y.data(), a, i, b, r)) {
+          ear = false;
+          break;
+        }
+      }
       if (st.budget < 0 && !out_of_budget) out_of_budget = true, st.fan_fallbacks++;
     }
     if (!ear && !out_of_budget && misses <= remaining) {
@@ -160,18 +91,16 @@ static void ear_clip(const std::vector<double>& x, const std::vector<double>& y,
     }
     tris.insert(tris.end(), {a, i, b});
     alive[i] = 0;
-    deactivate(i);
     next[a] = b;
     prev[b] = a;
     remaining--;
     for (int v : {a, b}) {
+      bool was = reflex[v];
       reflex[v] = cross2(x.data(), y.data(), prev[v], v, next[v]) < 0;
-      if (!reflex[v]) deactivate(v);
-      else if (place[v] < 0) place[v] = int(active.size()), active.push_back(v);
-      if (reflex[v] && !listed[v]) grid.late.push_back(v), listed[v] = 1;
+      if (reflex[v] && !was) reflex_list.push_back(v);
     }
     misses = 0;
-    i = next[b];
+    i = a;
   }
   tris.insert(tris.end(), {prev[i], i, next[i]});
 }
