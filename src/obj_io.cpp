@@ -123,6 +123,24 @@ static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& 
   int n = int(p.size());
   tris.clear();
   if (n == 3) return tris.assign({0, 1, 2});
+  // Corners at the position of the corner before them (a vertex written twice in a row, or two vertices at one point)
+  // are left out: their zero-length edge made both copies look straight (cross product 0), which hid a reflex corner
+  // from the convexity and ear tests (an L with its inner corner written twice was fanned over its notch: a triangle
+  // of negative area, the sum 1.4 times the outline).
+  auto same = [&](int a, int b) { return p[a].x == p[b].x && p[a].y == p[b].y && p[a].z == p[b].z; };
+  std::vector<int> keep;
+  for (int i = 0; i < n; i++)
+    if (keep.empty() || !same(i, keep.back())) keep.push_back(i);
+  while (keep.size() > 1 && same(keep.back(), keep.front())) keep.pop_back();
+  if (int(keep.size()) < n) {
+    if (keep.size() < 3) return;  // a point or a segment: no area
+    std::vector<vec3f> q;
+    for (int k : keep) q.push_back(p[size_t(k)]);
+    std::vector<int> sub;
+    triangulate_polygon(q, st, sub);
+    for (int t : sub) tris.push_back(keep[size_t(t)]);
+    return;
+  }
   // Newell normal (twice the vector area) relative to corner 0, in double for robust signs.
   double nx = 0, ny = 0, nz = 0;
   for (int i = 1; i + 1 < n; i++) {

@@ -168,6 +168,27 @@ TEST_CASE("a concave polygon in a tilted plane is triangulated inside its outlin
   CHECK(area == Approx(3.0f * std::sqrt(2.0f)));
 }
 
+TEST_CASE("a corner written twice in a row does not hide a concave polygon's notch", "[obj]") {
+  // Its zero-length edge made both copies of the notch's corner look straight, so the polygon was taken as convex and
+  // fanned over the notch: 4 triangles of area 14 (one of them turned over) for an outline of area 10.
+  temp_dir dir;
+  const std::string v = "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 2 1 0\nv 2 1 0\nv 0 4 0\n";
+  for (const std::string& face : {"f 1 2 3 4 4 6\n", "f 1 2 3 4 5 6\n", "f 6 5 4 3 2 1\n", "f 1 1 2 3 4 6 6\n"}) {
+    mesh_data m = load_obj(dir.write("notch.obj", v + face));
+    INFO(face);
+    check_invariants(m);
+    REQUIRE(triangle_count(m) == 3);
+    float area = 0;
+    float sign = face == "f 6 5 4 3 2 1\n" ? -1.0f : 1.0f;
+    for (int t = 0; t < 3; t++) {
+      vec3f a = area_vector(m, t);
+      CHECK(sign * a.z > 0);  // every triangle keeps the polygon's winding
+      area += 0.5f * length(a);
+    }
+    CHECK(area == Approx(10.0f));
+  }
+}
+
 TEST_CASE("negative indices count back from the latest element", "[obj]") {
   temp_dir dir;
   auto obj = dir.write("neg.obj", "v 5 5 5\n" + std::string(square_vertices) +
