@@ -128,11 +128,13 @@ static void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& 
   // from the convexity and ear tests (an L with its inner corner written twice was fanned over its notch: a triangle
   // of negative area, the sum 1.4 times the outline).
   auto same = [&](int a, int b) { return p[a].x == p[b].x && p[a].y == p[b].y && p[a].z == p[b].z; };
-  std::vector<int> keep;
-  for (int i = 0; i < n; i++)
-    if (keep.empty() || !same(i, keep.back())) keep.push_back(i);
-  while (keep.size() > 1 && same(keep.back(), keep.front())) keep.pop_back();
-  if (int(keep.size()) < n) {
+  bool repeats = false;  // (checked first: most polygons have none, and load time should not pay for a list)
+  for (int i = 0; i < n && !repeats; i++) repeats = same(i, (i + 1) % n);
+  if (repeats) {
+    std::vector<int> keep;
+    for (int i = 0; i < n; i++)
+      if (keep.empty() || !same(i, keep.back())) keep.push_back(i);
+    while (keep.size() > 1 && same(keep.back(), keep.front())) keep.pop_back();
     if (keep.size() < 3) return;  // a point or a segment: no area
     std::vector<vec3f> q;
     for (int k : keep) q.push_back(p[size_t(k)]);
