@@ -67,6 +67,7 @@ struct render_options {
   double checkpoint_every = 30;
   std::string resume;
   int stop_after_passes = -1;  // testing aid: raise SIGINT after this many passes (0: while the render sets up)
+  bool signal_after_last_pass = false;  // testing aid: raise SIGINT once the last pass is done, before the outputs
   int kill_after_passes = 0;  // testing aid: raise SIGKILL right after the checkpoint of this pass
   std::vector<std::pair<std::string, std::string>> given;  // options given on the command line: (name, help group)
 };
@@ -339,6 +340,7 @@ int run_render(const render_options& o) {
   std::string checkpoint_failure;
   params.on_pass = [&](const render_result& r, const light_sampler& s, bool last) {
     if (!last && o.stop_after_passes > 0 && r.passes == o.stop_after_passes) std::raise(SIGINT);
+    if (last && o.signal_after_last_pass) std::raise(SIGINT);
     // A render stopped before its first pass has nothing to save: a checkpoint already there is kept.
     if (o.checkpoint.empty() || r.passes == 0) return;
     auto now = std::chrono::steady_clock::now();
@@ -585,6 +587,9 @@ void add_render_command(CLI::App& app, render_options& o) {
                 "Continue the render saved in FILE (same scene and options; --spp may be larger: the same bytes as one render "
                 "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...)")
       ->check(file_name);
+  r->add_flag("--signal-after-last-pass", o.signal_after_last_pass,
+              "testing: raise SIGINT once the last pass is done, before the outputs are written")
+      ->group("");
   r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes (0: during set-up)")
       ->group("");
   r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")

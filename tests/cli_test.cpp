@@ -952,6 +952,21 @@ TEST_CASE("an interrupted render writes the completed passes and exits 130 or 14
   }
 }
 
+TEST_CASE("a signal after the last pass still ends the render as interrupted, with every output written", "[cli]") {
+  // It exited 0: a caller that sent SIGINT or SIGTERM was told the render had simply finished.
+  tiny_scene s;
+  const std::string base = "render " + s.json + " --quiet --spp 12 --sampler bayes";
+  auto r = run_bayeslight(base + " --signal-after-last-pass -o " + (s.dir / "a.pfm") + " -o " + (s.dir / "a.png") +
+                          " --log " + (s.dir / "a.csv"));
+  INFO(r.output);
+  CHECK(r.status == 130);
+  CHECK(r.output.find("interrupted (SIGINT) after the last pass; every output was written") != std::string::npos);
+  REQUIRE(run_bayeslight(base + " -o " + (s.dir / "b.pfm")).status == 0);
+  CHECK(read_text(s.dir / "a.pfm") == read_text(s.dir / "b.pfm"));  // the whole render, not its passes so far
+  CHECK(exists(s.dir / "a.png"));
+  CHECK(read_text(s.dir / "a.csv").find("bayes,10,12,") != std::string::npos);  // its last pass, 12 spp
+}
+
 TEST_CASE("profile with --time times the same samples twice and reports their stages", "[cli]") {
   // Both renders ran to the time budget and reached different spp, while every stage was divided by the first one's
   // NEE count (about 20 % off in a review). The timed render now takes the plain render's spp.
