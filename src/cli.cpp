@@ -94,18 +94,17 @@ constexpr long long max_pixels = 1ll << 28;
 void check_output_path(const std::string& path) {
   fs::path p(path);
   fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  // One status of the path (links followed): a loop, a directory, or an existing FIFO or device (/dev/stdout,
+  // /dev/null), which is written in place, so that its directory need not be writable.
   std::error_code ec;
+  const fs::file_status st = fs::status(p, ec);
+  if (ec == std::errc::too_many_symbolic_link_levels) throw output_error("cannot write " + path + ": " + ec.message());
+  if (!ec && fs::is_directory(st)) throw output_error("cannot write " + path + ": is a directory");
+  if (!ec && fs::exists(st) && !fs::is_regular_file(st)) return;
   if (fs::is_symlink(fs::symlink_status(p, ec))) {
-    (void)fs::status(p, ec);
-    if (ec == std::errc::too_many_symbolic_link_levels) throw output_error("cannot write " + path + ": " + ec.message());
     fs::path target = fs::path(output_target(path)).parent_path();  // where it points
     if (!target.empty()) dir = target;
   }
-  ec.clear();
-  if (fs::is_directory(p, ec)) throw output_error("cannot write " + path + ": is a directory");
-  // An existing FIFO or device (/dev/stdout, /dev/null) is written in place: its directory need not be writable.
-  fs::file_status st = fs::status(p, ec);
-  if (!ec && fs::exists(st) && !fs::is_regular_file(st)) return;
   if (!fs::is_directory(dir, ec)) throw output_error("cannot write " + path + ": directory " + dir.string() + " does not exist");
   if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write " + path + ": directory " + dir.string() + " is not writable");
 }
