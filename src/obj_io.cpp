@@ -286,7 +286,7 @@ struct sweep_triangulator {
     for (int v = 0; v < n; v++) first[size_t(v) + 1] = 2;
     for (auto [a, b] : diagonals) first[size_t(a) + 1]++, first[size_t(b) + 1]++;
     for (int v = 0; v < n; v++) first[size_t(v) + 1] += first[size_t(v)];
-    std::vector<int> to(size_t(first[size_t(n)])), fill(first.begin(), first.end() - 1);
+    std::vector<int> to(static_cast<size_t>(first[size_t(n)])), fill(first.begin(), first.end() - 1);
     for (int v = 0; v < n; v++) {
       to[size_t(fill[size_t(v)]++)] = (v + 1) % n;
       to[size_t(fill[size_t((v + 1) % n)]++)] = v;
