@@ -132,6 +132,14 @@ struct sweep_triangulator {
   bool west_of(int a, int b) const {
     if (a == b) return false;
     int ua = upper(a), ub = upper(b);
+    // The probe stands for the polygon's inside just west of its corner, so an edge through the corner's point lies
+    // east of it. (Only in weakly simple outlines, where another corner has the same point — a bridge to a hole
+    // written twice — does an edge of the sweep status touch the corner queried.)
+    if (a == n || b == n) {
+      int e = a == n ? b : a;
+      bool e_west = turn(upper(e), lower(e), probe) > 0;
+      return a == n ? !e_west : e_west;
+    }
     if (ua != ub) {
       double t = above(ub, ua) ? turn(ub, lower(b), ua) : -turn(ua, lower(a), ub);
       if (t != 0) return t < 0;
@@ -359,7 +367,8 @@ bool sweep_triangulate(const std::vector<double>& x, const std::vector<double>& 
   for (const auto& piece : parts)
     if (!s.triangulate_monotone(piece, out)) return false;
   if (out.size() != 3 * (x.size() - 2)) return false;
-  // Every triangle counter-clockwise (up to rounding) and their areas adding up to the polygon's: no overlap.
+  // The pieces' triangles have signed areas adding up to the outline's (by construction; checked as a guard), so with
+  // n-2 of them none turned over (up to rounding) means none overlaps another: an exact triangulation.
   int n = int(x.size());
   double area = 0, scale = 0;
   for (int i = 1; i + 1 < n; i++) area += cross2(x.data(), y.data(), 0, i, i + 1);
@@ -392,10 +401,19 @@ static void triangulate_concave(const std::vector<double>& x, const std::vector<
     reflex += cross2(x.data(), y.data(), int((i + n - 1) % n), int(i), int((i + 1) % n)) < 0;
   if (n * reflex <= ear_clip_max_work) {
     triangulate_state trial;
-    trial.budget = std::min(st.budget, ear_clip_max_steps);
+    bool file_limited = st.budget <= ear_clip_max_steps;
+    trial.budget = file_limited ? st.budget : ear_clip_max_steps;
     ear_clip(x, y, trial, tris);
-    st.budget -= std::min(st.budget, ear_clip_max_steps) - trial.budget;
+    st.budget -= (file_limited ? st.budget : ear_clip_max_steps) - trial.budget;
     if (trial.fan_fallbacks == 0) return;
+    if (file_limited) {
+      // The file's budget, not the trial's cap, ran out: what ear clipping gives now, partly fanned, stands unless
+      // the sweep does better (clipping again would only fan more).
+      std::vector<int> sweep;
+      if (sweep_triangulate(x, y, sweep)) return tris.swap(sweep);
+      st.fan_fallbacks++;
+      return;
+    }
     tris.clear();
   }
   if (sweep_triangulate(x, y, tris)) return;

@@ -819,6 +819,38 @@ outline notched_square(int k) {
   return o;
 }
 
+// A row of `units` keyholes: each a square hole joined to the top of a notch in the outline's bottom by a bridge written
+// twice (the bridge goes on from the notch's wall), beside a slot from the top that reaches below the hole's top.
+outline keyholes(int units) {
+  outline o;
+  o.add(0, 0);
+  for (int k = 0; k < units; k++) {
+    double ox = 8.0 * k;
+    o.add(ox + 2, 0), o.add(ox + 2, 2), o.add(ox + 4, 2);                      // the notch (x 2 to 4, up to 2)
+    o.add(ox + 4, 4), o.add(ox + 2, 4), o.add(ox + 2, 6), o.add(ox + 4, 6);    // bridge up, round the hole
+    o.add(ox + 4, 4), o.add(ox + 4, 2), o.add(ox + 4, 0), o.add(ox + 8, 0);    // bridge down, on down the wall
+  }
+  for (int k = units - 1; k >= 0; k--) {
+    double ox = 8.0 * k;
+    o.add(ox + 8, 8), o.add(ox + 7, 8), o.add(ox + 7, 5), o.add(ox + 6, 5), o.add(ox + 6, 8);  // the slot
+  }
+  o.add(0, 8);
+  return o;
+}
+
+// o turned (0: as it is, 1: mirrored in x, 2: mirrored in y, 3: half a turn), still counter-clockwise, its corner list
+// starting at corner `start`.
+outline transformed(const outline& o, int how, size_t start) {
+  outline t;
+  size_t n = o.x.size();
+  for (size_t k = 0; k < n; k++) {
+    size_t i = (start + k) % n;
+    if (how == 1 || how == 2) i = n - 1 - i;  // a mirror image runs the other way round
+    t.add(how == 1 || how == 3 ? -o.x[i] : o.x[i], how == 2 || how == 3 ? -o.y[i] : o.y[i]);
+  }
+  return t;
+}
+
 double shoelace(const outline& o) {
   double a = 0;
   for (size_t i = 0; i < o.x.size(); i++) {
@@ -881,6 +913,16 @@ TEST_CASE("the monotone sweep triangulates simple polygons exactly", "[obj]") {
   cases.push_back({"keyhole, bridge at a corner", keyhole({0, 4, 4, 0, 0, 1, 1, 3, 3, 1}, {0, 0, 4, 4, 0, 1, 3, 3, 1, 1})});
   cases.push_back({"keyhole, slanted bridge", keyhole({0, 4, 4, 0, 0, 1, 1, 3, 3, 1}, {0, 0, 4, 4, 0, 1.5, 3, 3, 1, 1.5})});
   cases.push_back({"keyhole, slot", keyhole({0, 4, 4, 3, 3, 1, 1, 3, 3, 4, 4, 0}, {0, 0, 2, 2, 1, 1, 3, 3, 2, 2, 4, 4})});
+  // Corners at one point (the bridges' ends) are ordered by index, so every turn and starting corner: a review found
+  // the sweep joining a corner to the other copy of its point (its status took the copy's edge as the one west of it).
+  cases.push_back({"keyhole, slot on the bridge", keyhole({0, 3, 3, 4, 4, 2, 2, 2, 2, 1, 1, 2, 2, 1, 1, 0},
+                                                          {0, 0, 3, 3, 4, 4, 3, 2, 1, 1, 2, 2, 3, 3, 4, 4})});
+  for (int units = 1; units <= 3; units++)
+    for (int how = 0; how < 4; how++)
+      for (size_t start = 0; start < keyholes(units).x.size(); start++)
+        cases.push_back({"keyholes " + std::to_string(units) + " turned " + std::to_string(how) + " from " +
+                             std::to_string(start),
+                         transformed(keyholes(units), how, start)});
   for (int k = 0; k < 200; k++) {
     std::vector<double> r(size_t(4 + k % 50));
     for (double& v : r) v = 0.2 + uniform();
@@ -946,7 +988,11 @@ TEST_CASE("concave polygons of many corners load as exact triangulations", "[obj
       {"comb", comb(100000, 10)},
       {"zigzag", zigzag(25000)},
       {"spiral", spiral(50, 50000)},
-      {"notched square", notched_square(25000)}};
+      {"notched square", notched_square(25000)},
+      {"keyholes", keyholes(2000)},
+      {"keyholes mirrored in x", transformed(keyholes(2000), 1, 0)},
+      {"keyholes mirrored in y", transformed(keyholes(2000), 2, 0)},
+      {"keyholes turned half a turn", transformed(keyholes(2000), 3, 0)}};
   for (auto& [name, o] : shapes) {
     INFO(name);
     for (size_t i = 0; i < o.x.size(); i++) o.x[i] = double(float(o.x[i])), o.y[i] = double(float(o.y[i]));
