@@ -108,9 +108,10 @@ static void ear_clip(const std::vector<double>& x, const std::vector<double>& y,
 
 // Monotone sweep triangulation (the decomposition into y-monotone pieces of de Berg et al., Computational Geometry,
 // ch. 3, then each piece by its two chains): O(n log n) steps whatever the shape, for the polygons whose ear clipping
-// would cost too much. It returns false, leaving tris as it found it, when the polygon turns out not to be simple
-// (a spike, a corner on another edge, crossing edges: a step finds what a simple polygon cannot have, or the
-// triangles fail the final check of winding and total area); the caller then ear-clips.
+// would cost too much; weakly simple outlines too (corners at one point, as where a bridge to a hole is written twice).
+// It returns false, leaving tris as it found it, when the polygon turns out not to be (weakly) simple (a spike,
+// crossing edges: a step finds what such a polygon cannot have, or a triangle comes out turned over); the caller
+// then ear-clips.
 namespace {
 
 struct sweep_triangulator {
@@ -131,7 +132,6 @@ struct sweep_triangulator {
   // of the other on which its upper corner lies; ties (a shared upper corner) by the lower corners, then by index.
   bool west_of(int a, int b) const {
     if (a == b) return false;
-    int ua = upper(a), ub = upper(b);
     // The probe stands for the polygon's inside just west of its corner, so an edge through the corner's point lies
     // east of it. (Only in weakly simple outlines, where another corner has the same point — a bridge to a hole
     // written twice — does an edge of the sweep status touch the corner queried.)
@@ -140,6 +140,7 @@ struct sweep_triangulator {
       bool e_west = turn(upper(e), lower(e), probe) > 0;
       return a == n ? !e_west : e_west;
     }
+    int ua = upper(a), ub = upper(b);
     if (ua != ub) {
       double t = above(ub, ua) ? turn(ub, lower(b), ua) : -turn(ua, lower(a), ub);
       if (t != 0) return t < 0;
@@ -806,7 +807,7 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
               << " repeating another (same corners, same side; an emissive one is kept first, else the first)\n";
   if (st.fan_fallbacks > 0)
     std::cerr << "warning: " << path << ": " << st.fan_fallbacks
-              << " polygon(s) that cross or touch themselves, too complex to ear-clip in the time budget, were "
+              << " polygon(s) that cross themselves, too complex to ear-clip in the time budget, were "
                  "fan-triangulated\n";
   if (mesh.tri_materials.empty())
     throw input_error(path,
