@@ -109,9 +109,9 @@ static void ear_clip(const std::vector<double>& x, const std::vector<double>& y,
 // Monotone sweep triangulation (the decomposition into y-monotone pieces of de Berg et al., Computational Geometry,
 // ch. 3, then each piece by its two chains): O(n log n) steps whatever the shape, for the polygons whose ear clipping
 // would cost too much; weakly simple outlines too (corners at one point, as where a bridge to a hole is written twice).
-// It returns false, leaving tris as it found it, when the polygon turns out not to be (weakly) simple (a spike,
-// crossing edges: a step finds what such a polygon cannot have, or a triangle comes out turned over); the caller
-// then ear-clips.
+// It returns false, leaving tris as it found it, when a step finds what such a polygon cannot have (a dead end: two
+// edges out and back along one line; crossing edges) or a triangle comes out turned over; the caller then sweeps the
+// polygon without its dead ends, or ear-clips.
 namespace {
 
 struct sweep_triangulator {
@@ -395,6 +395,53 @@ bool sweep_triangulate(const std::vector<double>& x, const std::vector<double>& 
 constexpr long long ear_clip_max_work = 1 << 24;
 constexpr long long ear_clip_max_steps = 1 << 26;
 
+// The corners of a polygon without its dead ends: where the outline runs out along a line and straight back (a slit
+// cut into the surface, or a hair sticking out of it) its far end is left out, and so is a corner at the point of the
+// one before; repeated until none is left. That is the same surface (a dead end has no area), but one the monotone
+// sweep can order (a dead end's two edges lie along one line). Empty when there was none.
+static std::vector<int> without_dead_ends(const std::vector<double>& x, const std::vector<double>& y) {
+  int n = int(x.size());
+  auto same = [&](int a, int b) { return x[a] == x[b] && y[a] == y[b]; };
+  auto dead_end = [&](int a, int b, int c) {  // b is the far end of a run a -> b -> c out and back
+    return cross2(x.data(), y.data(), a, b, c) == 0 && (x[b] - x[a]) * (x[c] - x[b]) + (y[b] - y[a]) * (y[c] - y[b]) < 0;
+  };
+  bool any = false;
+  for (int i = 0; i < n && !any; i++) any = dead_end((i + n - 1) % n, i, (i + 1) % n);
+  if (!any) return {};
+  std::vector<int> kept;  // a stack of corners; kept[head..] is the polygon (corners leave the front at the seam)
+  for (int c = 0; c < n; c++) {
+    bool drop = !kept.empty() && same(kept.back(), c);
+    while (!drop && kept.size() >= 2 && dead_end(kept[kept.size() - 2], kept.back(), c)) {
+      kept.pop_back();
+      drop = same(kept.back(), c);
+    }
+    if (!drop) kept.push_back(c);
+  }
+  size_t head = 0;
+  for (bool changed = true; changed && kept.size() - head >= 3;) {  // where the polygon closes
+    size_t m = kept.size();
+    changed = true;
+    if (same(kept[m - 1], kept[head])) kept.pop_back();
+    else if (dead_end(kept[m - 2], kept[m - 1], kept[head])) kept.pop_back();
+    else if (dead_end(kept[m - 1], kept[head], kept[head + 1])) head++;
+    else changed = false;
+  }
+  return std::vector<int>(kept.begin() + long(head), kept.end());
+}
+
+// The sweep, and when it refuses a polygon with dead ends, the sweep of the polygon without them.
+static bool sweep_with_dead_ends(const std::vector<double>& x, const std::vector<double>& y, std::vector<int>& tris) {
+  if (sweep_triangulate(x, y, tris)) return true;
+  std::vector<int> kept = without_dead_ends(x, y);
+  if (kept.size() < 3) return false;  // none (or nothing but dead ends: no area)
+  std::vector<double> kx, ky;
+  for (int k : kept) kx.push_back(x[size_t(k)]), ky.push_back(y[size_t(k)]);
+  std::vector<int> sub;
+  if (!sweep_triangulate(kx, ky, sub)) return false;
+  for (int t : sub) tris.push_back(kept[size_t(t)]);
+  return true;
+}
+
 static void triangulate_concave(const std::vector<double>& x, const std::vector<double>& y, triangulate_state& st,
                                 std::vector<int>& tris) {
   long long n = (long long)x.size(), reflex = 0;
@@ -411,13 +458,13 @@ static void triangulate_concave(const std::vector<double>& x, const std::vector<
       // The file's budget, not the trial's cap, ran out: what ear clipping gives now, partly fanned, stands unless
       // the sweep does better (clipping again would only fan more).
       std::vector<int> sweep;
-      if (sweep_triangulate(x, y, sweep)) return tris.swap(sweep);
+      if (sweep_with_dead_ends(x, y, sweep)) return tris.swap(sweep);
       st.fan_fallbacks++;
       return;
     }
     tris.clear();
   }
-  if (sweep_triangulate(x, y, tris)) return;
+  if (sweep_with_dead_ends(x, y, tris)) return;
   ear_clip(x, y, st, tris);
 }
 

@@ -1077,3 +1077,31 @@ TEST_CASE("the monotone sweep triangulates random simple polygons of grid points
   }
   CHECK(tested > 1000);
 }
+
+TEST_CASE("dead ends in concave polygons of many corners load as exact triangulations", "[obj]") {
+  // A slit cut into the surface or a hair sticking out of it (the outline runs out along a line and straight back)
+  // has no area, but the sweep cannot order its two edges along one line: a review's comb with one slit in its base
+  // was refused and fanned (25 times its area). The loader sweeps the polygon without its dead ends.
+  temp_dir dir;
+  outline base = comb(5000, 10);  // corners: (0, 0), (9999, 0), ..., (0, 11)
+  outline o;
+  auto copy = [&](size_t from, size_t to) {
+    for (size_t i = from; i < to; i++) o.add(base.x[i], base.y[i]);
+  };
+  o.add(0, 0);
+  o.add(5000, 0), o.add(5000, 0.5), o.add(5000, 0);                                         // a slit
+  o.add(7000, 0), o.add(7000, 0.25), o.add(7000, 0.5), o.add(7000, 0.25), o.add(7000, 0);  // one of three corners
+  copy(1, base.x.size());
+  o.add(0, 0.5), o.add(-3, 0.5), o.add(0, 0.5);  // a hair out of the left side
+  mesh_data m = load_outline(dir, o);
+  double area = 0;
+  int turned = 0;
+  for (int t = 0; t < triangle_count(m); t++) {
+    vec3f a = area_vector(m, t);
+    turned += a.z < 0;
+    area += 0.5 * std::fabs(double(a.z));
+  }
+  CHECK(turned == 0);
+  CHECK(area == Approx(shoelace(base)).epsilon(1e-6));
+  CHECK(shoelace(o) == shoelace(base));  // (dead ends add no area)
+}
