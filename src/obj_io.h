@@ -60,14 +60,6 @@ corner_key triangle_corner_key(const std::vector<vec3f>& positions, const int* c
 // share it, so grouping by it finds repeats and reverses without comparing every pair.
 uint64_t corner_set_hash(const std::vector<vec3f>& positions, const int* corners);
 
-// The monotone sweep load_obj triangulates large concave polygons with (its ear clipping would take too long): the
-// corners (x[i], y[i]) of a simple counter-clockwise polygon give n-2 counter-clockwise triangles of corner indices,
-// appended to tris, in O(n log n) steps; so do weakly simple ones with corners at one point (a bridge to a hole
-// written twice). False, tris untouched, when it meets what such a polygon cannot have: crossing edges, or a dead end
-// (two edges along one line, out and back: load_obj sweeps the polygon without them). Some self-crossing polygons
-// are triangulated all the same, covering where the outline winds twice twice, as ear clipping does.
-bool sweep_triangulate(const std::vector<double>& x, const std::vector<double>& y, std::vector<int>& tris);
-
 // Loads an OBJ file with its MTL libraries (relative to the OBJ's folder) and the map_Kd / map_d textures of
 // the materials it uses (relative to their MTL's folder). Unrecognised statements are reported on stderr.
 mesh_data load_obj(const std::string& path);

@@ -6,6 +6,7 @@
 #include "obj_io.h"
 #include "obj_validate.h"
 #include "scene.h"
+#include "triangulate.h"
 
 #include <catch2/catch.hpp>
 #include <stb_image_write.h>
