@@ -136,8 +136,10 @@ struct sweep_triangulator {
       bool pa = above(p, v), qa = above(q, v);
       double t = turn(p, v, q);
       if (pa == qa && t == 0) return false;  // a spike: both edges along one line
-      type[size_t(v)] = !pa && !qa ? (t > 0 ? start : split) : pa && qa ? (t > 0 ? end : merge)
-                        : pa ? regular_down : regular_up;
+      type[size_t(v)] = !pa && !qa ? (t > 0 ? start : split)
+                        : pa && qa ? (t > 0 ? end : merge)
+                        : pa       ? regular_down
+                                   : regular_up;
     }
     std::set<int, order> status(order{this});
     std::vector<std::set<int, order>::iterator> where(static_cast<size_t>(n));
@@ -221,14 +223,18 @@ struct sweep_triangulator {
       int c = take_west ? piece[size_t(w)] : piece[size_t(e)];
       if (!above(order.back().first, c)) return false;  // not monotone
       order.push_back({c, take_west});
-      if (take_west) w = (w + 1) % m;
-      else e = (e + m - 1) % m;
+      if (take_west)
+        w = (w + 1) % m;
+      else
+        e = (e + m - 1) % m;
     }
     // A triangle of corner c and the stacked edge (s, t), s above t, wound counter-clockwise: a west chain runs down
     // counter-clockwise, an east chain up.
     auto emit = [&](int c, int s, int t, bool west) {
-      if (west) tris.insert(tris.end(), {s, t, c});
-      else tris.insert(tris.end(), {c, t, s});
+      if (west)
+        tris.insert(tris.end(), {s, t, c});
+      else
+        tris.insert(tris.end(), {c, t, s});
     };
     std::vector<std::pair<int, bool>> stack = {order[0], order[1]};
     for (int j = 2; j < m - 1; j++) {
@@ -271,7 +277,10 @@ struct sweep_triangulator {
     for (auto [a, b] : diagonals) to[size_t(fill[size_t(a)]++)] = b, to[size_t(fill[size_t(b)]++)] = a;
     for (int v = 0; v < n; v++) {
       // Counter-clockwise from the east: the upper half-plane (and east) first, then by turn.
-      auto half = [&](int u) { double dy = y[u] - y[v]; return dy > 0 || (dy == 0 && x[u] > x[v]) ? 0 : 1; };
+      auto half = [&](int u) {
+        double dy = y[u] - y[v];
+        return dy > 0 || (dy == 0 && x[u] > x[v]) ? 0 : 1;
+      };
       std::sort(to.begin() + first[size_t(v)], to.begin() + first[size_t(v) + 1], [&](int a, int b) {
         int ha = half(a), hb = half(b);
         if (ha != hb) return ha < hb;
@@ -371,7 +380,8 @@ static std::vector<int> without_dead_ends(const std::vector<double>& x, const st
   int n = int(x.size());
   auto same = [&](int a, int b) { return x[a] == x[b] && y[a] == y[b]; };
   auto dead_end = [&](int a, int b, int c) {  // b is the far end of a run a -> b -> c out and back
-    return cross2(x.data(), y.data(), a, b, c) == 0 && (x[b] - x[a]) * (x[c] - x[b]) + (y[b] - y[a]) * (y[c] - y[b]) < 0;
+    return cross2(x.data(), y.data(), a, b, c) == 0 &&
+           (x[b] - x[a]) * (x[c] - x[b]) + (y[b] - y[a]) * (y[c] - y[b]) < 0;
   };
   bool any = false;
   for (int i = 0; i < n && !any; i++) any = dead_end((i + n - 1) % n, i, (i + 1) % n);
@@ -389,10 +399,14 @@ static std::vector<int> without_dead_ends(const std::vector<double>& x, const st
   for (bool changed = true; changed && kept.size() - head >= 3;) {  // where the polygon closes
     size_t m = kept.size();
     changed = true;
-    if (same(kept[m - 1], kept[head])) kept.pop_back();
-    else if (dead_end(kept[m - 2], kept[m - 1], kept[head])) kept.pop_back();
-    else if (dead_end(kept[m - 1], kept[head], kept[head + 1])) head++;
-    else changed = false;
+    if (same(kept[m - 1], kept[head]))
+      kept.pop_back();
+    else if (dead_end(kept[m - 2], kept[m - 1], kept[head]))
+      kept.pop_back();
+    else if (dead_end(kept[m - 1], kept[head], kept[head + 1]))
+      head++;
+    else
+      changed = false;
   }
   return std::vector<int>(kept.begin() + long(head), kept.end());
 }
@@ -438,7 +452,9 @@ static void triangulate_concave(const std::vector<double>& x, const std::vector<
 
 // The polygon corner with the smallest position (x, then y, then z; the first of equal ones): a choice that does
 // not depend on where the corner list starts or which way it runs.
-static bool corner_less(vec3f a, vec3f b) { return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z; }
+static bool corner_less(vec3f a, vec3f b) {
+  return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+}
 static int smallest_corner(const std::vector<vec3f>& p) {
   int m = 0;
   for (int i = 1; i < int(p.size()); i++)
@@ -529,8 +545,10 @@ void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& st, std
   triangulate_polygon(q, st, canonical);  // (q starts at its smallest corner and goes toward the smaller neighbour)
   for (size_t t = 0; t + 2 < canonical.size(); t += 3) {
     int a = from[size_t(canonical[t])], b = from[size_t(canonical[t + 1])], c = from[size_t(canonical[t + 2])];
-    if (forward) tris.insert(tris.end(), {a, b, c});
-    else tris.insert(tris.end(), {a, c, b});
+    if (forward)
+      tris.insert(tris.end(), {a, b, c});
+    else
+      tris.insert(tris.end(), {a, c, b});
   }
 }
 

@@ -6,9 +6,9 @@
 // reversed twins; the result depends only on the corner positions (double maths of float inputs, no hashing).
 #pragma once
 
-#include "math.h"
-
 #include <vector>
+
+#include "math.h"
 
 namespace bl {
 

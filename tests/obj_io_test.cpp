@@ -786,7 +786,7 @@ outline comb(int teeth, double h, bool down = false) {
   return o;
 }
 
-// A band zigzagging n times between heights 0 and 1, of thickness 0.5 (4n corners).
+// A band zigzagging n times between heights 0 and 1, 0.5 thick (2n + 2 corners).
 outline zigzag(int n) {
   outline o;
   for (int i = 0; i <= n; i++) o.add(i, (i % 2) ? 1.0 : 0.0);
@@ -820,16 +820,17 @@ outline notched_square(int k) {
   return o;
 }
 
-// A row of `units` keyholes: each a square hole joined to the top of a notch in the outline's bottom by a bridge written
-// twice (the bridge goes on from the notch's wall), beside a slot from the top that reaches below the hole's top.
+// A row of `units` keyholes: each a square hole joined to the top of a notch in the outline's bottom by a bridge
+// written twice (the bridge goes on from the notch's wall), beside a slot from the top that reaches below the hole's
+// top.
 outline keyholes(int units) {
   outline o;
   o.add(0, 0);
   for (int k = 0; k < units; k++) {
     double ox = 8.0 * k;
-    o.add(ox + 2, 0), o.add(ox + 2, 2), o.add(ox + 4, 2);                      // the notch (x 2 to 4, up to 2)
-    o.add(ox + 4, 4), o.add(ox + 2, 4), o.add(ox + 2, 6), o.add(ox + 4, 6);    // bridge up, round the hole
-    o.add(ox + 4, 4), o.add(ox + 4, 2), o.add(ox + 4, 0), o.add(ox + 8, 0);    // bridge down, on down the wall
+    o.add(ox + 2, 0), o.add(ox + 2, 2), o.add(ox + 4, 2);                    // the notch (x 2 to 4, up to 2)
+    o.add(ox + 4, 4), o.add(ox + 2, 4), o.add(ox + 2, 6), o.add(ox + 4, 6);  // bridge up, round the hole
+    o.add(ox + 4, 4), o.add(ox + 4, 2), o.add(ox + 4, 0), o.add(ox + 8, 0);  // bridge down, on down the wall
   }
   for (int k = units - 1; k >= 0; k--) {
     double ox = 8.0 * k;
@@ -901,7 +902,12 @@ TEST_CASE("the monotone sweep triangulates simple polygons exactly", "[obj]") {
   };
   std::vector<std::pair<std::string, outline>> cases = {
       {"triangle", star(3, [](int) { return 1.0; })},
-      {"L", [] { outline o; o.add(0, 0), o.add(2, 0), o.add(2, 1), o.add(1, 1), o.add(1, 2), o.add(0, 2); return o; }()},
+      {"L",
+       [] {
+         outline o;
+         o.add(0, 0), o.add(2, 0), o.add(2, 1), o.add(1, 1), o.add(1, 2), o.add(0, 2);
+         return o;
+       }()},
       {"comb up", comb(7, 3)},
       {"comb down", comb(7, 3, true)},
       {"zigzag", zigzag(9)},
@@ -910,10 +916,17 @@ TEST_CASE("the monotone sweep triangulates simple polygons exactly", "[obj]") {
       {"alternating star", star(40, [](int i) { return i % 2 ? 0.5 : 1.0; })},
   };
   // Keyholes: a square hole joined to the outline by a bridge written twice (as exporters write holes).
-  auto keyhole = [](std::vector<double> x, std::vector<double> y) { outline o; o.x = x, o.y = y; return o; };
-  cases.push_back({"keyhole, bridge at a corner", keyhole({0, 4, 4, 0, 0, 1, 1, 3, 3, 1}, {0, 0, 4, 4, 0, 1, 3, 3, 1, 1})});
-  cases.push_back({"keyhole, slanted bridge", keyhole({0, 4, 4, 0, 0, 1, 1, 3, 3, 1}, {0, 0, 4, 4, 0, 1.5, 3, 3, 1, 1.5})});
-  cases.push_back({"keyhole, slot", keyhole({0, 4, 4, 3, 3, 1, 1, 3, 3, 4, 4, 0}, {0, 0, 2, 2, 1, 1, 3, 3, 2, 2, 4, 4})});
+  auto keyhole = [](std::vector<double> x, std::vector<double> y) {
+    outline o;
+    o.x = x, o.y = y;
+    return o;
+  };
+  cases.push_back(
+      {"keyhole, bridge at a corner", keyhole({0, 4, 4, 0, 0, 1, 1, 3, 3, 1}, {0, 0, 4, 4, 0, 1, 3, 3, 1, 1})});
+  cases.push_back(
+      {"keyhole, slanted bridge", keyhole({0, 4, 4, 0, 0, 1, 1, 3, 3, 1}, {0, 0, 4, 4, 0, 1.5, 3, 3, 1, 1.5})});
+  cases.push_back(
+      {"keyhole, slot", keyhole({0, 4, 4, 3, 3, 1, 1, 3, 3, 4, 4, 0}, {0, 0, 2, 2, 1, 1, 3, 3, 2, 2, 4, 4})});
   // Corners at one point (the bridges' ends) are ordered by index, so every turn and starting corner: a review found
   // the sweep joining a corner to the other copy of its point (its status took the copy's edge as the one west of it).
   cases.push_back({"keyhole, slot on the bridge", keyhole({0, 3, 3, 4, 4, 2, 2, 2, 2, 1, 1, 2, 2, 1, 1, 0},
@@ -921,9 +934,9 @@ TEST_CASE("the monotone sweep triangulates simple polygons exactly", "[obj]") {
   for (int units = 1; units <= 3; units++)
     for (int how = 0; how < 4; how++)
       for (size_t start = 0; start < keyholes(units).x.size(); start++)
-        cases.push_back({"keyholes " + std::to_string(units) + " turned " + std::to_string(how) + " from " +
-                             std::to_string(start),
-                         transformed(keyholes(units), how, start)});
+        cases.push_back(
+            {"keyholes " + std::to_string(units) + " turned " + std::to_string(how) + " from " + std::to_string(start),
+             transformed(keyholes(units), how, start)});
   for (int k = 0; k < 200; k++) {
     std::vector<double> r(size_t(4 + k % 50));
     for (double& v : r) v = 0.2 + uniform();
@@ -1090,7 +1103,7 @@ TEST_CASE("dead ends in concave polygons of many corners load as exact triangula
     for (size_t i = from; i < to; i++) o.add(base.x[i], base.y[i]);
   };
   o.add(0, 0);
-  o.add(5000, 0), o.add(5000, 0.5), o.add(5000, 0);                                         // a slit
+  o.add(5000, 0), o.add(5000, 0.5), o.add(5000, 0);                                        // a slit
   o.add(7000, 0), o.add(7000, 0.25), o.add(7000, 0.5), o.add(7000, 0.25), o.add(7000, 0);  // one of three corners
   copy(1, base.x.size());
   o.add(0, 0.5), o.add(-3, 0.5), o.add(0, 0.5);  // a hair out of the left side
