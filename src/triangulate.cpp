@@ -368,15 +368,16 @@ bool sweep_triangulate(const std::vector<double>& x, const std::vector<double>& 
 // polygons of real files, but walks round and round some shapes (a comb of 4096 teeth spent the file's budget of 2e8
 // steps). It is tried where n times the reflex corners is at most ear_clip_max_work, for at most ear_clip_max_steps;
 // the monotone sweep (n log n) takes over beyond that, and ear clipping within the file's budget only when the sweep
-// finds the polygon not simple.
+// refuses the polygon (one that crosses itself).
 constexpr long long ear_clip_max_work = 1 << 24;
 constexpr long long ear_clip_max_steps = 1 << 26;
 
 // The corners of a polygon without its dead ends: where the outline runs out along a line and straight back (a slit
 // cut into the surface, or a hair sticking out of it) its far end is left out, and so is a corner at the point of the
 // one before; repeated until none is left. That is the same surface (a dead end has no area), but one the monotone
-// sweep can order (a dead end's two edges lie along one line). Empty when there was none.
-static std::vector<int> without_dead_ends(const std::vector<double>& x, const std::vector<double>& y) {
+// sweep can order (it refuses any dead end: its two edges lie along one line). False, kept untouched, when there is
+// none.
+static bool without_dead_ends(const std::vector<double>& x, const std::vector<double>& y, std::vector<int>& kept) {
   int n = int(x.size());
   auto same = [&](int a, int b) { return x[a] == x[b] && y[a] == y[b]; };
   auto dead_end = [&](int a, int b, int c) {  // b is the far end of a run a -> b -> c out and back
@@ -385,37 +386,38 @@ static std::vector<int> without_dead_ends(const std::vector<double>& x, const st
   };
   bool any = false;
   for (int i = 0; i < n && !any; i++) any = dead_end((i + n - 1) % n, i, (i + 1) % n);
-  if (!any) return {};
-  std::vector<int> kept;  // a stack of corners; kept[head..] is the polygon (corners leave the front at the seam)
+  if (!any) return false;
+  std::vector<int> stack;  // stack[head..] is the polygon (corners leave the front where it closes)
   for (int c = 0; c < n; c++) {
-    bool drop = !kept.empty() && same(kept.back(), c);
-    while (!drop && kept.size() >= 2 && dead_end(kept[kept.size() - 2], kept.back(), c)) {
-      kept.pop_back();
-      drop = same(kept.back(), c);
+    bool drop = !stack.empty() && same(stack.back(), c);
+    while (!drop && stack.size() >= 2 && dead_end(stack[stack.size() - 2], stack.back(), c)) {
+      stack.pop_back();
+      drop = same(stack.back(), c);
     }
-    if (!drop) kept.push_back(c);
+    if (!drop) stack.push_back(c);
   }
   size_t head = 0;
-  for (bool changed = true; changed && kept.size() - head >= 3;) {  // where the polygon closes
-    size_t m = kept.size();
+  for (bool changed = true; changed && stack.size() - head >= 3;) {  // where the polygon closes
+    size_t m = stack.size();
     changed = true;
-    if (same(kept[m - 1], kept[head]))
-      kept.pop_back();
-    else if (dead_end(kept[m - 2], kept[m - 1], kept[head]))
-      kept.pop_back();
-    else if (dead_end(kept[m - 1], kept[head], kept[head + 1]))
+    if (same(stack[m - 1], stack[head]))
+      stack.pop_back();
+    else if (dead_end(stack[m - 2], stack[m - 1], stack[head]))
+      stack.pop_back();
+    else if (dead_end(stack[m - 1], stack[head], stack[head + 1]))
       head++;
     else
       changed = false;
   }
-  return std::vector<int>(kept.begin() + long(head), kept.end());
+  kept.assign(stack.begin() + long(head), stack.end());
+  return true;
 }
 
-// The sweep, and when it refuses a polygon with dead ends, the sweep of the polygon without them.
+// The sweep of the polygon, or of what is left of it without its dead ends.
 static bool sweep_with_dead_ends(const std::vector<double>& x, const std::vector<double>& y, std::vector<int>& tris) {
-  if (sweep_triangulate(x, y, tris)) return true;
-  std::vector<int> kept = without_dead_ends(x, y);
-  if (kept.size() < 3) return false;  // none (or nothing but dead ends: no area)
+  std::vector<int> kept;
+  if (!without_dead_ends(x, y, kept)) return sweep_triangulate(x, y, tris);
+  if (kept.size() < 3) return false;  // nothing but dead ends: no area
   std::vector<double> kx, ky;
   for (int k : kept) kx.push_back(x[size_t(k)]), ky.push_back(y[size_t(k)]);
   std::vector<int> sub;
@@ -462,10 +464,10 @@ static int smallest_corner(const std::vector<vec3f>& p) {
   return m;
 }
 
-// Triangulates one polygon with corner positions p into n-2 triangles of local corner indices (winding kept).
-// Convex quads split along the shorter diagonal (as tinyobjloader does; of equal ones, the one through the smallest
-// corner), other convex polygons fan from their smallest corner, concave ones are ear-clipped in the plane of
-// their Newell normal.
+// Triangulates one polygon with corner positions p into n-2 triangles of local corner indices (winding kept; fewer
+// where corners repeat or dead ends are left out). Convex quads split along the shorter diagonal (as tinyobjloader
+// does; of equal ones, the one through the smallest corner), other convex polygons fan from their smallest corner,
+// concave ones are ear-clipped or swept (triangulate_concave) in the plane of their Newell normal.
 void triangulate_polygon(const std::vector<vec3f>& p, triangulate_state& st, std::vector<int>& tris) {
   int n = int(p.size());
   tris.clear();
