@@ -1,7 +1,7 @@
-// third_party: the implementations of stb_image (+ stb_image_write), tinyexr and tinyobjloader compiled from
+// third_party: the implementations of stb_image (+ stb_image_write) and tinyexr compiled from
 // their Debian headers into the fuzz build only, so that the decoders the parsers call are instrumented for
 // coverage and ASan/UBSan too (the Debian shared libraries the normal build links are opaque to both).
-// Same versions and defaults as those libraries (tinyexr: zlib, no threads; tinyobjloader: float).
+// Same versions and defaults as those libraries (tinyexr: zlib, no threads).
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image.h>
@@ -9,6 +9,3 @@
 
 #define TINYEXR_IMPLEMENTATION
 #include <tinyexr.h>
-
-#define TINYOBJLOADER_IMPLEMENTATION
-#include <tiny_obj_loader.h>

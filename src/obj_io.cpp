@@ -1,7 +1,6 @@
-// obj_io: turns a validated OBJ (obj_validate) into mesh_data. tinyobjloader parses the clean text (index
-// triples, negative indices, usemtl ids; its counts are checked against the validator's, whose correctly
-// rounded numbers we keep); we triangulate (triangulate.h), drop degenerate triangles, compact the vertex arrays
-// and load each distinct texture once.
+// obj_io: turns a validated OBJ (obj_validate: vertex values, faces as resolved corner triples, materials) into
+// mesh_data: we triangulate (triangulate.h), drop degenerate triangles, compact the vertex arrays and load each
+// distinct texture once.
 // Invariants: triangles keep the polygon's winding and come in file order; arrays hold only referenced
 // elements, in file order; nothing iterates a hash or pointer order; geometry tests are float maths.
 #include "obj_io.h"
@@ -10,8 +9,6 @@
 #include "obj_validate.h"
 #include "rng.h"
 #include "triangulate.h"
-
-#include <tiny_obj_loader.h>
 
 #include <sys/stat.h>
 
@@ -23,10 +20,8 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
-#include <istream>
 #include <map>
 #include <new>
-#include <stdexcept>
 
 namespace bl {
 
@@ -135,50 +130,6 @@ static void check_emitted_power(const std::string& path, const obj_clean_data& c
   }
 }
 
-// What tinyobjloader parsed from the clean text.
-struct tinyobj_result {
-  tinyobj::attrib_t attrib;
-  std::vector<tinyobj::shape_t> shapes;
-};
-
-// A read-only stream buffer over a string, so that tinyobjloader reads the clean text without a copy.
-struct string_view_buf : std::streambuf {
-  explicit string_view_buf(const std::string& s) {
-    char* p = const_cast<char*>(s.data());  // get area only: never written through
-    setg(p, p, p + s.size());
-  }
-};
-
-// Parses the clean text with tinyobjloader (LoadObj, the parser behind ObjReader) and checks it read what the
-// validator saw.
-static tinyobj_result parse_clean(const std::string& path, const obj_clean_data& clean) {
-  // No materials: the validator parsed the real MTL files, and the faces' materials are clean.face_materials (a
-  // placeholder library of one material per name cost tinyobjloader 1.9 KB each: 760 MB for 400k names).
-  string_view_buf obj_buf(clean.obj_text);
-  std::istream obj_in(&obj_buf);
-  tinyobj_result r;
-  std::vector<tinyobj::material_t> materials;
-  std::string warn, err;
-  // triangulate = false: its ear clipping loses or flips triangles of concave polygons, so we triangulate.
-  if (!tinyobj::LoadObj(&r.attrib, &r.shapes, &materials, &warn, &err, &obj_in, nullptr, false, false))
-    throw std::logic_error(path + ": tinyobjloader rejected validated text: " + err);
-  const auto& a = r.attrib;
-  size_t faces = 0, corners = 0;
-  bool same = a.vertices.size() == 3 * clean.positions.size() && a.normals.size() == 3 * clean.normals.size() &&
-              a.texcoords.size() == 2 * clean.texcoords.size() && r.shapes.size() <= 1;
-  for (const auto& s : r.shapes) {
-    for (size_t f = 0; same && f < s.mesh.num_face_vertices.size(); f++, faces++) {
-      same = faces < clean.face_sizes.size() && s.mesh.num_face_vertices[f] == (clean.face_sizes[faces] & 0xff) &&
-             s.mesh.material_ids[f] == -1;
-      corners += size_t(same ? clean.face_sizes[faces] : 0);
-    }
-    same = same && corners == s.mesh.indices.size();
-  }
-  if (!same || faces != clean.face_sizes.size())
-    throw std::logic_error(path + ": tinyobjloader read the validated OBJ differently (loader bug)");
-  return r;
-}
-
 uint64_t corner_set_hash(const std::vector<vec3f>& positions, const int* corners) {
   uint64_t h = 0;
   for (int i = 0; i < 3; i++) {
@@ -267,7 +218,7 @@ static std::pair<int, int> drop_repeated_triangles(mesh_data& mesh, const std::v
 }
 
 // Builds the mesh from the parsed OBJ: triangles, compacted vertex arrays, materials and textures.
-static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean, const tinyobj_result& parsed) {
+static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean) {
   auto position = [&](size_t i) { return clean.positions[i]; };
   std::vector<vec3f> normals(clean.normals.size());
   std::vector<char> normal_ok(normals.size());
@@ -278,33 +229,28 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   std::vector<vec3f> corner_pos;
   std::vector<int> local;
   int default_material = int(clean.materials.size());
-  size_t face = 0;  // faces in file order across shapes (there is at most one shape)
-  for (const auto& s : parsed.shapes) {
-    size_t next_index = 0;
-    for (size_t f = 0; f < s.mesh.material_ids.size(); f++, face++) {
-      int n = clean.face_sizes[face];
-      const tinyobj::index_t* c = &s.mesh.indices[next_index];
-      next_index += size_t(n);
-      corner_pos.resize(size_t(n));
-      for (int i = 0; i < n; i++) corner_pos[size_t(i)] = position(size_t(c[i].vertex_index));
-      triangulate_polygon(corner_pos, st, local);
-      int material = clean.face_materials[face] >= 0 ? clean.face_materials[face] : default_material;
-      for (size_t t = 0; t < local.size(); t += 3) {
-        const tinyobj::index_t* tc[3] = {&c[local[t]], &c[local[t + 1]], &c[local[t + 2]]};
-        if (!good_triangle(position(size_t(tc[0]->vertex_index)), position(size_t(tc[1]->vertex_index)),
-                           position(size_t(tc[2]->vertex_index)))) {
-          mesh.dropped_degenerate++;
-          continue;
-        }
-        for (auto* x : tc) {
-          mesh.tri_positions.push_back(x->vertex_index);
-          bool has_n = x->normal_index >= 0 && normal_ok[size_t(x->normal_index)];
-          mesh.tri_normals.push_back(has_n ? x->normal_index : invalid_id);
-          mesh.tri_texcoords.push_back(x->texcoord_index >= 0 ? x->texcoord_index : invalid_id);
-        }
-        mesh.tri_materials.push_back(material);
-        if (mesh.tri_materials.size() > size_t(INT_MAX / 3)) throw input_error(path, "too many triangles");
+  size_t next_corner = 0;
+  for (size_t face = 0; face < clean.face_sizes.size(); face++) {
+    int n = clean.face_sizes[face];
+    const obj_corner* c = &clean.corners[next_corner];
+    next_corner += size_t(n);
+    corner_pos.resize(size_t(n));
+    for (int i = 0; i < n; i++) corner_pos[size_t(i)] = position(size_t(c[i].v));
+    triangulate_polygon(corner_pos, st, local);
+    int material = clean.face_materials[face] >= 0 ? clean.face_materials[face] : default_material;
+    for (size_t t = 0; t < local.size(); t += 3) {
+      const obj_corner* tc[3] = {&c[local[t]], &c[local[t + 1]], &c[local[t + 2]]};
+      if (!good_triangle(position(size_t(tc[0]->v)), position(size_t(tc[1]->v)), position(size_t(tc[2]->v)))) {
+        mesh.dropped_degenerate++;
+        continue;
       }
+      for (const obj_corner* x : tc) {
+        mesh.tri_positions.push_back(x->v);
+        mesh.tri_normals.push_back(x->vn >= 0 && normal_ok[size_t(x->vn)] ? x->vn : invalid_id);
+        mesh.tri_texcoords.push_back(x->vt);
+      }
+      mesh.tri_materials.push_back(material);
+      if (mesh.tri_materials.size() > size_t(INT_MAX / 3)) throw input_error(path, "too many triangles");
     }
   }
   std::vector<char> emissive(clean.materials.size() + 1, 0);  // the last: the default material
@@ -364,10 +310,7 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
 
 mesh_data load_obj(const std::string& path) {
   try {
-    obj_clean_data clean = validate_obj(path);
-    tinyobj_result parsed = parse_clean(path, clean);
-    clean.obj_text = std::string();
-    return build_mesh(path, clean, parsed);
+    return build_mesh(path, validate_obj(path));
   } catch (const std::bad_alloc&) {
     throw input_error(path, "out of memory while loading (input too large?)");
   } catch (const std::length_error&) {

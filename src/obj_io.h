@@ -1,4 +1,4 @@
-// obj_io: reads a Wavefront OBJ and its MTL files into flat arrays (validated first, tinyobjloader underneath).
+// obj_io: reads a Wavefront OBJ and its MTL files into flat arrays (obj_validate reads them).
 // Invariants: every returned triangle has finite vertices and non-zero float area (degenerate ones are dropped
 // and counted); every index is valid; polygons are triangulated keeping their winding; triangles are in file
 // order and the vertex arrays hold only referenced elements, in file order. Malformed input throws input_error

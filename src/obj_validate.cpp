@@ -1,5 +1,5 @@
-// obj_validate: line-by-line checks of OBJ and MTL text, written to accept only what tinyobjloader parses
-// exactly as we read it (its number grammar, its index forms) and to name file and line on every rejection.
+// obj_validate: reads OBJ and MTL text line by line, accepting tinyobjloader's number grammar and index forms (the
+// loader once parsed with it; the files it took load as they did) and naming file and line on every rejection.
 // Invariants: lines end at \n, \r\n or a lone \r (a statement ending in a backslash continues on the next); a
 // token starting with '#' starts a comment (in material and texture names only a lone '#': "Material #1" is a
 // name); tokens are split at spaces, tabs, \v and \f; numbers are finite floats of at most max_number_chars
@@ -68,8 +68,8 @@ struct line_reader {
   }
   bool next_physical(string_view& out) {
     if (pos >= text.size()) return false;
-    size_t end = text.find_first_of("\r\n", pos);
-    if (end == std::string::npos) end = text.size();
+    size_t end = pos;  // (a plain loop: find_first_of searches its set once per character)
+    while (end < text.size() && text[end] != '\n' && text[end] != '\r') end++;
     out = string_view(text).substr(pos, end - pos);
     pos = end + ((end + 1 < text.size() && text[end] == '\r' && text[end + 1] == '\n') ? 2 : 1);
     physical++;
@@ -134,12 +134,10 @@ static std::string join_from(const std::vector<string_view>& t, size_t first) {
 
 // True when t follows tinyobjloader's number grammar in full: [sign] (digits [. digits] | . digits)
 // [(e|E) [sign] digits]; exponent_too_big when the decimal exponent is above 300 (a negative one of any size is
-// fine: the value rounds to a denormal or 0 in our strtof and in tinyobjloader's ldexp alike); exponent_below_300
-// (when given) when it is below -300.
-static bool number_grammar(string_view t, bool& exponent_too_big, bool* exponent_below_300 = nullptr) {
+// fine: the value rounds to a denormal or 0).
+static bool number_grammar(string_view t, bool& exponent_too_big) {
   size_t i = 0, n = t.size();
   exponent_too_big = false;
-  if (exponent_below_300) *exponent_below_300 = false;
   if (i < n && (t[i] == '+' || t[i] == '-')) i++;
   size_t digits = 0;
   while (i < n && t[i] >= '0' && t[i] <= '9') i++, digits++;
@@ -160,15 +158,8 @@ static bool number_grammar(string_view t, bool& exponent_too_big, bool* exponent
     }
     if (exp_digits == 0) return false;
     exponent_too_big = !negative && exponent > 300;
-    if (exponent_below_300) *exponent_below_300 = negative && exponent > 300;
   }
   return i == n;
-}
-
-// Whether number t (number_grammar's) has a decimal exponent below -300.
-static bool exponent_below_300(string_view t) {
-  bool too_big = false, below = false;
-  return number_grammar(t, too_big, &below) && below;
 }
 
 // Parses t as a number (see number_grammar) into out; false (with a reason) when it is not one.
@@ -205,8 +196,9 @@ static float number_at(string_view t, const text_pos& pos) {
   return v;
 }
 
-// Resolves one OBJ index component (1-based, negative = relative) against count elements defined so far.
-static void check_index(string_view t, int count, const char* what, const text_pos& pos) {
+// Resolves one OBJ index component (1-based, negative = relative) against count elements defined so far: the
+// 0-based index.
+static int check_index(string_view t, int count, const char* what, const text_pos& pos) {
   size_t i = (!t.empty() && (t[0] == '+' || t[0] == '-')) ? 1 : 0;
   bool digits_only = i < t.size();
   for (size_t k = i; k < t.size(); k++) digits_only = digits_only && t[k] >= '0' && t[k] <= '9';
@@ -222,30 +214,31 @@ static void check_index(string_view t, int count, const char* what, const text_p
                    : std::string(what) == "vertex" ? "vertices"
                                                    : std::string(what) + "s") +
                   " defined so far)");
+  return int(resolved);
 }
 
-// Checks one face corner: v, v/vt, v//vn or v/vt/vn.
-// Returns the corner as tinyobjloader is given it: an empty trailing part dropped with its slash ("1/" and "1//" are
-// "1", "1/2/" is "1/2", as other OBJ readers take them).
-static string_view check_corner(string_view c, const obj_clean_data& d, const text_pos& pos) {
+// Reads one face corner: v, v/vt, v//vn or v/vt/vn, with an empty trailing part taken as not written ("1/" and
+// "1//" are "1", "1/2/" is "1/2", as other OBJ readers take them); the parts not written are invalid_id.
+static obj_corner check_corner(string_view c, const obj_clean_data& d, const text_pos& pos) {
   size_t s1 = c.find('/');
   if (s1 != string_view::npos && c.size() >= 2 && c.substr(c.size() - 2) == "//" && c.find('/') == c.size() - 2)
     c = c.substr(0, c.size() - 2);  // v//
   else if (s1 != string_view::npos && c.back() == '/' && std::count(c.begin(), c.end(), '/') <= 2)
     c = c.substr(0, c.size() - 1);  // v/ or v/vt/
+  obj_corner out{invalid_id, invalid_id, invalid_id};
   s1 = c.find('/');
   if (s1 == string_view::npos) {
-    check_index(c, int(d.positions.size()), "vertex", pos);
-    return c;
+    out.v = check_index(c, int(d.positions.size()), "vertex", pos);
+    return out;
   }
   size_t s2 = c.find('/', s1 + 1);
   if (s2 != string_view::npos && c.find('/', s2 + 1) != string_view::npos)
     fail(pos, "malformed face corner " + quote(c) + " (expected v, v/vt, v//vn or v/vt/vn)");
-  check_index(c.substr(0, s1), int(d.positions.size()), "vertex", pos);
+  out.v = check_index(c.substr(0, s1), int(d.positions.size()), "vertex", pos);
   string_view vt = c.substr(s1 + 1, s2 == string_view::npos ? string_view::npos : s2 - s1 - 1);
-  if (s2 == string_view::npos || !vt.empty()) check_index(vt, int(d.texcoords.size()), "texcoord", pos);
-  if (s2 != string_view::npos) check_index(c.substr(s2 + 1), int(d.normals.size()), "normal", pos);
-  return c;
+  if (s2 == string_view::npos || !vt.empty()) out.vt = check_index(vt, int(d.texcoords.size()), "texcoord", pos);
+  if (s2 != string_view::npos) out.vn = check_index(c.substr(s2 + 1), int(d.normals.size()), "normal", pos);
+  return out;
 }
 
 // The part of a name before its first word that starts with '#', blanks after it dropped ("" when it has none, or
@@ -572,8 +565,6 @@ obj_clean_data validate_obj(const std::string& path) {
   obj_pass_state st;
   st.folders = &d.folders;
   unknown_log unknown;
-  std::string body;  // the clean statements after the mtllib line
-  body.reserve(text.size());
   int current = invalid_id;  // material k of the next faces
   line_reader lines(text);
   std::vector<string_view> t;
@@ -603,20 +594,11 @@ obj_clean_data validate_obj(const std::string& path) {
       if (k == "v") d.positions.push_back({x[0], x[1], x[2]});
       if (k == "vn") d.normals.push_back({x[0], x[1], x[2]});
       if (k == "vt") d.texcoords.push_back({x[0], x[1]});
-      size_t keep = k == "vt" ? std::min<size_t>(args, 2) : 3;
-      body += k;
-      // (A number whose exponent is below -300 is 0, said as such: tinyobjloader's exponent parser overflows an
-      // int on ten digits; its value is never read, the positions are ours.)
-      for (size_t i = 1; i <= keep; i++) (body += ' ') += exponent_below_300(t[i]) ? string_view("0") : t[i];
-      body += '\n';
     } else if (k == "f") {
       if (args < 3) fail(pos, "a face needs at least 3 vertices, got " + std::to_string(args));
       if (args > size_t(INT_MAX / 4)) fail(pos, "face has too many vertices");
-      body += 'f';
-      for (size_t i = 1; i <= args; i++) {
-        (body += ' ') += check_corner(t[i], d, pos);
-      }
-      body += '\n';
+      if (d.corners.size() + args > size_t(INT_MAX)) fail(pos, "too many face corners");
+      for (size_t i = 1; i <= args; i++) d.corners.push_back(check_corner(t[i], d, pos));
       d.face_sizes.push_back(int(args));
       d.face_materials.push_back(current);
     } else if (k == "usemtl") {
@@ -693,7 +675,6 @@ obj_clean_data validate_obj(const std::string& path) {
   if (undefined > named_warnings)
     std::cerr << "warning: " << path << ": " << undefined - named_warnings
               << " more undefined materials: their faces get the default material too\n";
-  d.obj_text = std::move(body);
   return d;
 }
 

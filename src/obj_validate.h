@@ -1,9 +1,8 @@
-// obj_validate: the first pass of the OBJ loader. Reads the OBJ and every MTL it names exactly once, checks
-// each statement with its line number, and writes clean text for tinyobjloader plus the parsed materials.
-// Invariants: any input ends in an obj_clean_data or an input_error; the clean text holds only v, vn, vt, f
-// and usemtl statements (one per line, comments gone, every number and index already checked) and at most one
-// mtllib, so tinyobjloader parses exactly what was validated. Unrecognised statements are counted and reported
-// once per file on stderr.
+// obj_validate: the OBJ loader's reader. Reads the OBJ and every MTL it names exactly once, checks each
+// statement with its line number, and keeps what the mesh is built from: vertex values, faces as corner index
+// triples, the used materials.
+// Invariants: any input ends in an obj_clean_data or an input_error; every index in it is resolved (0-based) and in
+// range. Unrecognised statements are counted and reported once per file on stderr.
 #pragma once
 
 #include "obj_io.h"
@@ -23,7 +22,6 @@ struct mtl_material_data {
   int line = 0;          // its newmtl line there
 };
 
-// The validated OBJ: clean text for tinyobjloader and what the conversion needs beside it.
 // Folder listings for find_beside, read once per folder and load (a scene of 10000 missing names in a folder of
 // 2000 files listed the folder 10000 times: 6 s): folder -> lower-case file name -> the names with it.
 struct folder_cache {
@@ -34,13 +32,18 @@ struct folder_cache {
             const std::string& beside);
 };
 
+// One face corner: 0-based indices of its v, vt and vn (invalid_id where the corner has no such part).
+struct obj_corner {
+  int v, vt, vn;
+};
+
+// The validated OBJ.
 struct obj_clean_data {
-  std::string obj_text;                      // v/vn/vt/f lines only (materials: face_materials)
   std::vector<mtl_material_data> materials;  // used materials; k = order of first usemtl in the OBJ
   std::vector<int> face_sizes;               // corners of each face, in file order
   std::vector<int> face_materials;           // k of each face, or invalid_id before any usemtl
-  // v, vn and vt values as correctly rounded floats (strtof): tinyobjloader's own number parser uses double
-  // pow, whose last bit may differ between CPUs, so these, not its attrib, feed the mesh.
+  std::vector<obj_corner> corners;           // the faces' corners, face after face
+  // v, vn and vt values as correctly rounded floats (strtof, locale "C").
   std::vector<vec3f> positions, normals;
   std::vector<vec2f> texcoords;
   mutable folder_cache folders;  // find_beside's listings, kept for the textures the mesh build resolves
