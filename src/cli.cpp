@@ -33,6 +33,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 namespace bl {
 
@@ -262,6 +263,7 @@ int run_render(const render_options& o) {
       references.push_back(load_reference(frame_path(o.reference, f, animated), params));
   for (const image_data& r : references) params.frame_references.push_back(&r);
   auto t_load = std::chrono::steady_clock::now();
+  std::optional<slow_phase_note> loading(std::in_place, params.progress, "loading " + o.scene + " ...");
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
   report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
   {
@@ -279,6 +281,7 @@ int run_render(const render_options& o) {
   auto t_bvh = std::chrono::steady_clock::now();
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
+  loading.reset();
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", o.scene.c_str());
   if (lights.tri_count > 0) {
@@ -464,7 +467,7 @@ void add_render_options(CLI::App* r, render_options& o) {
       ->check(CLI::Range(1ll, max_side));
   r->add_option("--height", o.height, "Image height in pixels (default: the scene's image.height; at most 2^28 pixels in all)")
       ->check(CLI::Range(1ll, max_side));
-  r->add_flag("--quiet", o.quiet, "No progress bar or summary");
+  r->add_flag("--quiet", o.quiet, "No progress bar, notes of slow phases or summary");
   r->add_option("--pass-weighting", o.pass_weighting,
                 "Adaptive samplers (bayes, donikian): a pass after n spp counts (n+1)/(n+1+S) per sample, so the first "
                 "passes, taken before much is learned, weigh less; fixed in advance, so the image stays unbiased "
@@ -617,10 +620,12 @@ int run_profile_command(const render_options& o) {
   warn_unused_options(o, {kind});
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
+  std::optional<slow_phase_note> loading(std::in_place, params.progress, "loading " + o.scene + " ...");
   params.progress = false;
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
+  loading.reset();
   if (int status = interrupted_before_render()) return status;
   std::string report = profile_render(scene, bvh, lights, params, o.scene + " with the " + o.sampler + " sampler");
   std::fputs(report.c_str(), stdout);

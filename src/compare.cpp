@@ -6,6 +6,7 @@
 
 #include "errors.h"
 #include "file_io.h"
+#include "progress.h"
 #include "report.h"
 #include "svg_plot.h"
 
@@ -16,6 +17,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 namespace bl {
 
@@ -294,6 +296,7 @@ static void make_output_dir(const std::string& dir) {
 int run_compare(const scene_desc& desc, const compare_params& params) {
   const render_params& rp = params.render;
   image_data reference = read_reference(params.reference_path, rp.width, rp.height);
+  std::optional<slow_phase_note> loading(std::in_place, rp.progress, "loading " + desc.path + " ...");
   scene_data scene = build_scene(desc, float(rp.width) / float(rp.height));
   report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
   {
@@ -314,6 +317,7 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   }
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
+  loading.reset();
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", params.scene_path.c_str());
   make_output_dir(params.out_dir);

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <string>
+#include <utility>
 
 namespace bl {
 
@@ -66,6 +67,26 @@ void progress_bar::draw(bool final_line) {
                spp.c_str(), format_seconds(elapsed).c_str(), format_seconds(remaining).c_str());
   if (final_line) std::fprintf(stderr, "\n");
   std::fflush(stderr);
+}
+
+slow_phase_note::slow_phase_note(bool enabled, std::string text, std::chrono::milliseconds after)
+    : text_(std::move(text)) {
+  if (!enabled) return;
+  thread_ = std::thread([this, after] {
+    std::unique_lock<std::mutex> lock(mutex_);
+    // (A whole line: warnings the phase prints cannot land in the middle of it.)
+    if (!wake_.wait_for(lock, after, [this] { return done_; })) std::fprintf(stderr, "%s\n", text_.c_str());
+  });
+}
+
+slow_phase_note::~slow_phase_note() {
+  if (!thread_.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
 }
 
 }  // namespace bl

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
+#include <string>
 #include <thread>
 
 namespace bl {
@@ -39,6 +40,24 @@ class progress_bar {
   std::mutex mutex_;
   std::condition_variable wake_;
   bool stop_ = false;
+  std::thread thread_;
+};
+
+// A note on stderr for a phase that has no progress bar (loading the scene, the light sampler's set-up): `text` as a
+// line of its own once `after` has passed with the phase still running; nothing for a quick phase. Only when enabled
+// (the progress bar's condition: stderr a terminal, no --quiet). The phase ends when the note is destroyed.
+class slow_phase_note {
+ public:
+  slow_phase_note(bool enabled, std::string text, std::chrono::milliseconds after = std::chrono::milliseconds(1000));
+  ~slow_phase_note();
+  slow_phase_note(const slow_phase_note&) = delete;
+  slow_phase_note& operator=(const slow_phase_note&) = delete;
+
+ private:
+  std::string text_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool done_ = false;
   std::thread thread_;
 };
 

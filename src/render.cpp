@@ -341,6 +341,8 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   };
   std::optional<setup_scope> in_setup;
   in_setup.emplace();
+  std::optional<slow_phase_note> note(std::in_place, params.progress,
+                                      "setting up the light sampler (light tree, regions of the first hits) ...");
   light_tree_data tree;
   if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
   light_sampler sampler = make_light_sampler(params.sampler, in, tree);
@@ -348,6 +350,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   restored.width = params.width;
   restored.height = params.height;
   if (params.restore) params.restore(restored, sampler);
+  note.reset();
   in_setup.reset();
   bool resuming = !restored.film.empty();
   // (A resumed render's model was frozen by its oracle unless the oracle itself was interrupted: see below.)
@@ -362,7 +365,9 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     lp.reference = nullptr;
     lp.progress = false;
     render_result scratch;
+    note.emplace(params.progress, "learning the model of --bayes-oracle " + std::to_string(lp.spp) + " spp ...");
     render_with(learn_in, *b, lp, scratch);
+    note.reset();
     if (scratch.interrupted)
       // Cut short: nothing of it is kept, so a checkpoint saves an empty model and a resumed render learns it anew.
       sampler = make_light_sampler(params.sampler, in, tree);

@@ -1,0 +1,75 @@
+// Tests of the stderr notes for long phases without a progress bar (slow_phase_note): a line once the phase has run
+// long enough, nothing for a quick phase or when disabled, and no wait for the delay when the phase ends.
+#include "progress.h"
+
+#include <catch2/catch.hpp>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+using namespace bl;
+using namespace std::chrono_literals;
+
+namespace {
+
+// Sends file descriptor 2 to a temporary file while alive; text() reads what was written so far.
+struct stderr_capture {
+  std::string path;
+  int saved = -1;
+  stderr_capture() {
+    char name[] = "/tmp/bl_progress_test_XXXXXX";
+    int fd = mkstemp(name);
+    REQUIRE(fd >= 0);
+    path = name;
+    std::fflush(stderr);
+    saved = dup(2);
+    dup2(fd, 2);
+    close(fd);
+  }
+  ~stderr_capture() {
+    std::fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    std::remove(path.c_str());
+  }
+  std::string text() const {
+    std::fflush(stderr);
+    std::string out;
+    if (FILE* f = std::fopen(path.c_str(), "rb")) {
+      char buf[256];
+      for (size_t k; (k = std::fread(buf, 1, sizeof buf, f)) > 0;) out.append(buf, k);
+      std::fclose(f);
+    }
+    return out;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a phase that runs past the delay gets its note as one line, once", "[progress]") {
+  stderr_capture cap;
+  {
+    slow_phase_note note(true, "loading big.obj ...", 20ms);
+    // (Waits for the note rather than a fixed time: a loaded machine may start its thread late.)
+    for (int i = 0; i < 1000 && cap.text().empty(); i++) std::this_thread::sleep_for(10ms);
+  }
+  CHECK(cap.text() == "loading big.obj ...\n");
+}
+
+TEST_CASE("a quick phase, or a disabled note, writes nothing and ends without waiting", "[progress]") {
+  stderr_capture cap;
+  auto start = std::chrono::steady_clock::now();
+  { slow_phase_note note(true, "never shown", 1h); }
+  CHECK(std::chrono::steady_clock::now() - start < 30s);  // (an hour if the end waited for the delay)
+  {
+    slow_phase_note note(false, "disabled", 0ms);
+    std::this_thread::sleep_for(50ms);
+  }
+  CHECK(cap.text().empty());
+}
