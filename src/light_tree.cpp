@@ -52,8 +52,24 @@ struct build_bounds {
   cone_bound cone;
   float intensity = 0;
 };
-build_bounds merge_bounds(const build_bounds& a, const build_bounds& b) {
-  return {merge(a.box, b.box), cone_union(a.cone, b.cone), a.intensity + b.intensity};
+// a = the bounds of a and b, in place: cone_union(a.cone, b.cone) without copying cones where it returns one of
+// them (the common case; the same result bit for bit).
+void merge_into(build_bounds& a, const build_bounds& b) {
+  a.box = merge(a.box, b.box);
+  a.intensity += b.intensity;
+  if (b.cone.empty) return;
+  if (!a.cone.empty) {
+    const bool b_wider = b.cone.theta > a.cone.theta;  // (cone_union's swap)
+    const cone_bound& wide = b_wider ? b.cone : a.cone;
+    const cone_bound& narrow = b_wider ? a.cone : b.cone;
+    if (!(wide.theta >= pi_f) &&
+        !(dot(wide.axis, narrow.axis) >= wide.cos_t * narrow.cos_t + wide.sin_t * narrow.sin_t)) {
+      a.cone = cone_union(a.cone, b.cone);
+      return;
+    }
+    if (!b_wider) return;  // a's cone holds b's
+  }
+  a.cone = b.cone;
 }
 
 float surface_area(const bbox3f& b) {
@@ -66,7 +82,8 @@ float surface_area(const bbox3f& b) {
 float orientation_measure(const cone_bound& c) {
   float theta_o = c.theta, theta_e = 0.5f * pi_f;
   float theta_w = std::min(theta_o + theta_e, pi_f);
-  float so = std::sin(theta_o), co = std::cos(theta_o);
+  // (make_cone's cosine and sine below pi; at pi it holds 0 for the sine, where this measure has always taken sin(pi))
+  float so = theta_o < pi_f ? c.sin_t : std::sin(theta_o), co = theta_o < pi_f ? c.cos_t : std::cos(theta_o);
   return 2 * pi_f * (1 - co) +
          0.5f * pi_f * (2 * theta_w * so - std::cos(theta_o - 2 * theta_w) - 2 * theta_o * so + co);
 }
@@ -85,6 +102,7 @@ struct build_item {
 struct builder {
   light_tree_data& t;
   std::vector<build_item>& items;
+  static constexpr int parallel_items = 4096;  // larger ranges are split and binned by parallel tasks
 
   // Builds the subtree over items [b, e) as node `node` (depth-first numbering: its left child is node + 1, its
   // right child node + 2 (mid - b), since a subtree over k items has 2k - 1 nodes) and returns its depth. Large
@@ -95,7 +113,7 @@ struct builder {
     build_bounds bounds;
     bbox3f cbox;
     for (int i = b; i < e; i++) {
-      bounds = merge_bounds(bounds, items[size_t(i)].bounds);
+      merge_into(bounds, items[size_t(i)].bounds);
       cbox = merge(cbox, items[size_t(i)].centroid);
     }
     store(node, bounds);
@@ -110,7 +128,7 @@ struct builder {
     t.left[size_t(node)] = left;
     t.right[size_t(node)] = right;
     int dl = 0, dr = 0;
-    if (e - b > 4096) {
+    if (e - b > parallel_items) {
       tbb::parallel_invoke([&] { dl = build(b, mid, left, node, depth + 1); },
                            [&] { dr = build(mid, e, right, node, depth + 1); });
     } else {
@@ -127,9 +145,8 @@ struct builder {
     t.center[i] = center(bb.box);
     t.radius[i] = 0.5f * diagonal(bb.box);
     t.axis[i] = bb.cone.axis;
-    t.cos_o[i] = std::cos(bb.cone.theta);
-    t.sin_o[i] = std::sin(bb.cone.theta);
-    if (bb.cone.theta >= pi_f) t.cos_o[i] = -1, t.sin_o[i] = 0;
+    t.cos_o[i] = bb.cone.cos_t;  // (make_cone's: cos and sin of theta, -1 and 0 at pi)
+    t.sin_o[i] = bb.cone.sin_t;
     t.intensity[i] = bb.intensity;
   }
 
@@ -141,22 +158,30 @@ struct builder {
     float max_ext = max_component(ext);
     float best_cost = inf_f;
     int best_axis = -1, best_bin = -1;
+    // Each axis's bins (in item order, whichever thread fills them: the same bins on any thread count).
+    build_bounds bins_of[3][bins];
+    auto fill = [&](int axis) {
+      float lo = cbox.lo[axis], hi = cbox.hi[axis];
+      if (!(hi > lo) || depth >= max_sah_depth) return;
+      for (int i = b; i < e; i++) {
+        int k = std::min(bins - 1, int(bins * ((items[size_t(i)].centroid[axis] - lo) / (hi - lo))));
+        merge_into(bins_of[axis][k], items[size_t(i)].bounds);
+      }
+    };
+    if (e - b > parallel_items) tbb::parallel_invoke([&] { fill(0); }, [&] { fill(1); }, [&] { fill(2); });
+    else fill(0), fill(1), fill(2);
     for (int axis = 0; axis < 3 && depth < max_sah_depth; axis++) {
       float lo = cbox.lo[axis], hi = cbox.hi[axis];
       if (!(hi > lo)) continue;
-      build_bounds bin[bins];
-      for (int i = b; i < e; i++) {
-        int k = std::min(bins - 1, int(bins * ((items[size_t(i)].centroid[axis] - lo) / (hi - lo))));
-        bin[k] = merge_bounds(bin[k], items[size_t(i)].bounds);
-      }
+      const build_bounds* bin = bins_of[axis];
       build_bounds below[bins];
       build_bounds acc;
-      for (int k = 0; k < bins; k++) below[k] = acc = merge_bounds(acc, bin[k]);
+      for (int k = 0; k < bins; k++) merge_into(acc, bin[k]), below[k] = acc;
       acc = {};
       // Kr penalises thin slabs along the split axis (pbrt-v4's regularisation).
       float kr = ext[axis] > 0 ? max_ext / ext[axis] : 1.0f;
       for (int k = bins - 1; k >= 1; k--) {
-        acc = merge_bounds(acc, bin[k]);
+        merge_into(acc, bin[k]);
         if (below[k - 1].intensity == 0 && is_empty(below[k - 1].box)) continue;
         if (is_empty(acc.box)) continue;
         float cost = kr * (split_cost(below[k - 1]) + split_cost(acc));
