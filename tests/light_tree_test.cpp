@@ -12,6 +12,7 @@
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
+#include <tbb/global_control.h>
 
 #include <cstring>
 #include <functional>
@@ -317,6 +318,29 @@ TEST_CASE("light tree structure holds its invariants on random light sets", "[li
     CHECK(same_column(t.leaf_of_light, t2.leaf_of_light));
     CHECK(t.depth == t2.depth);
   }
+}
+
+TEST_CASE("a light tree built by parallel tasks does not depend on the thread count", "[light_tree]") {
+  // 10000 lights: ranges over 4096 build their halves and bin their axes in parallel tasks.
+  light_set s = make_light_set(8, 10000, layout::scattered, false);
+  light_tree_data one;
+  {
+    tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
+    one = build_light_tree(s.lights, s.scene);
+  }
+  tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+  light_tree_data t = build_light_tree(s.lights, s.scene);
+  REQUIRE(node_count(one) == node_count(t));
+  CHECK(same_column(t.lo, one.lo));
+  CHECK(same_column(t.hi, one.hi));
+  CHECK(same_column(t.axis, one.axis));
+  CHECK(same_column(t.cos_o, one.cos_o));
+  CHECK(same_column(t.sin_o, one.sin_o));
+  CHECK(same_column(t.intensity, one.intensity));
+  CHECK(same_column(t.left, one.left));
+  CHECK(same_column(t.right, one.right));
+  CHECK(same_column(t.light, one.light));
+  CHECK(same_column(t.left_prob, one.left_prob));
 }
 
 TEST_CASE("a scene without emitters has an empty light tree", "[light_tree]") {
