@@ -597,7 +597,6 @@ obj_clean_data validate_obj(const std::string& path) {
     } else if (k == "f") {
       if (args < 3) fail(pos, "a face needs at least 3 vertices, got " + std::to_string(args));
       if (args > size_t(INT_MAX / 4)) fail(pos, "face has too many vertices");
-      if (d.corners.size() + args > size_t(INT_MAX)) fail(pos, "too many face corners");
       for (size_t i = 1; i <= args; i++) d.corners.push_back(check_corner(t[i], d, pos));
       d.face_sizes.push_back(int(args));
       d.face_materials.push_back(current);
