@@ -177,13 +177,13 @@ TEST_CASE("a corner written twice in a row does not hide a concave polygon's not
   // fanned over the notch: 4 triangles of area 14 (one of them turned over) for an outline of area 10.
   temp_dir dir;
   const std::string v = "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 2 1 0\nv 2 1 0\nv 0 4 0\n";
-  for (const std::string& face : {"f 1 2 3 4 4 6\n", "f 1 2 3 4 5 6\n", "f 6 5 4 3 2 1\n", "f 1 1 2 3 4 6 6\n"}) {
+  for (const char* face : {"f 1 2 3 4 4 6\n", "f 1 2 3 4 5 6\n", "f 6 5 4 3 2 1\n", "f 1 1 2 3 4 6 6\n"}) {
     mesh_data m = load_obj(dir.write("notch.obj", v + face));
     INFO(face);
     check_invariants(m);
     REQUIRE(triangle_count(m) == 3);
     float area = 0;
-    float sign = face == "f 6 5 4 3 2 1\n" ? -1.0f : 1.0f;
+    float sign = std::string(face) == "f 6 5 4 3 2 1\n" ? -1.0f : 1.0f;
     for (int t = 0; t < 3; t++) {
       vec3f a = area_vector(m, t);
       CHECK(sign * a.z > 0);  // every triangle keeps the polygon's winding
