@@ -3,6 +3,8 @@
 // usage_error (exit 2): a bad command line. output_error and anything else escaping main is exit 1.
 #pragma once
 
+#include <cstdio>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -47,6 +49,19 @@ struct output_failures {
   // Throws one output_error naming every failure (each on its own line, as main prints errors), if any.
   void rethrow() const {
     if (!messages.empty()) throw output_error(messages);
+  }
+};
+
+// A warning (or any text for stderr) assembled with << and written with one fwrite when it goes out of scope (a
+// temporary: at the end of its statement), so that a line another thread prints meanwhile (slow_phase_note) cannot
+// land inside it as it could between the pieces std::cerr writes one by one.
+struct stderr_text : std::ostringstream {
+  stderr_text() = default;
+  stderr_text(const stderr_text&) = delete;
+  stderr_text& operator=(const stderr_text&) = delete;
+  ~stderr_text() override {
+    const std::string s = str();
+    std::fwrite(s.data(), 1, s.size(), stderr);
   }
 };
 

@@ -19,7 +19,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <iostream>
 #include <map>
 #include <new>
 
@@ -259,15 +258,16 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   for (size_t k = 0; k < clean.materials.size(); k++) cutout[k] = !clean.materials[k].alpha_map.empty();
   auto [repeated, copies] = drop_repeated_triangles(mesh, clean.positions, emissive, cutout);
   if (repeated > 0)
-    std::cerr << "warning: " << path << ": dropped " << repeated << " emissive triangle" << (repeated > 1 ? "s" : "")
-              << " repeating an earlier one (same corners, same side), which would light the scene once per copy\n";
+    stderr_text() << "warning: " << path << ": dropped " << repeated << " emissive triangle"
+                  << (repeated > 1 ? "s" : "")
+                  << " repeating an earlier one (same corners, same side), which would light the scene once per copy\n";
   if (copies > 0)
-    std::cerr << "warning: " << path << ": dropped " << copies << " triangle" << (copies > 1 ? "s" : "")
-              << " repeating another (same corners, same side; an emissive one is kept first, else the first)\n";
+    stderr_text() << "warning: " << path << ": dropped " << copies << " triangle" << (copies > 1 ? "s" : "")
+                  << " repeating another (same corners, same side; an emissive one is kept first, else the first)\n";
   if (st.fan_fallbacks > 0)
-    std::cerr << "warning: " << path << ": " << st.fan_fallbacks
-              << " polygon(s) that cross themselves, too complex to ear-clip in the time budget, were "
-                 "fan-triangulated\n";
+    stderr_text() << "warning: " << path << ": " << st.fan_fallbacks
+                  << " polygon(s) that cross themselves, too complex to ear-clip in the time budget, were "
+                     "fan-triangulated\n";
   if (mesh.tri_materials.empty())
     throw input_error(path,
                       "no triangles" + (mesh.dropped_degenerate > 0
@@ -291,8 +291,8 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
     mesh.materials.push_back(md);
   }
   if (clean.folders.unsaid > 0)
-    std::cerr << "warning: " << path << ": " << clean.folders.unsaid
-              << " more texture or library names that do not exist were taken from beside the files naming them\n";
+    stderr_text() << "warning: " << path << ": " << clean.folders.unsaid
+                  << " more texture or library names that do not exist were taken from beside the files naming them\n";
   for (int m : mesh.tri_materials)
     if (m == default_material) {
       mesh.materials.push_back(material_data{});

@@ -16,7 +16,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <iostream>
 #include <map>
 #include <set>
 #include <string_view>
@@ -262,8 +261,8 @@ struct unknown_log {
   }
   void report(const std::string& file) const {
     if (count > 0)
-      std::cerr << "warning: " << file << ": ignored " << count << " unrecognised statement" << (count > 1 ? "s" : "")
-                << " (first " << first << " at line " << first_line << ")\n";
+      stderr_text() << "warning: " << file << ": ignored " << count << " unrecognised statement"
+                    << (count > 1 ? "s" : "") << " (first " << first << " at line " << first_line << ")\n";
   }
 };
 
@@ -293,8 +292,8 @@ void folder_cache::note(const std::string& file, int line, const std::string& wh
     return;
   }
   said++;
-  std::cerr << "warning: " << file << ":" << line << ": " << what << ": " << name << " does not exist; using " << beside
-            << "\n";
+  stderr_text() << "warning: " << file << ":" << line << ": " << what << ": " << name << " does not exist; using "
+                << beside << "\n";
 }
 
 std::string find_beside(const std::string& dir, const std::string& written, folder_cache& cache) {
@@ -499,18 +498,19 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     std::string list;
     for (size_t i = 0; i < std::min(bright.size(), named); i++) list += (i > 0 ? ", " : "") + bright[i];
     if (bright.size() > named) list += " and " + std::to_string(bright.size() - named) + " more";
-    std::cerr << "warning: " << path << ": material" << (bright.size() > 1 ? "s " : " ") << list
-              << (bright.size() > 1 ? " have" : " has") << " Kd + Ks above 1, scaled down to conserve energy\n";
+    stderr_text() << "warning: " << path << ": material" << (bright.size() > 1 ? "s " : " ") << list
+                  << (bright.size() > 1 ? " have" : " has") << " Kd + Ks above 1, scaled down to conserve energy\n";
   }
   if (!ignored_order.empty()) {
-    std::cerr << "warning: " << path << ": textures other than map_Kd and map_d are not rendered:";
+    stderr_text w;
+    w << "warning: " << path << ": textures other than map_Kd and map_d are not rendered:";
     for (size_t i = 0; i < ignored_order.size(); i++)
-      std::cerr << (i ? ", " : " ") << ignored_order[i] << " (line " << ignored_maps[ignored_order[i]] << ")";
-    std::cerr << "\n";
+      w << (i ? ", " : " ") << ignored_order[i] << " (line " << ignored_maps[ignored_order[i]] << ")";
+    w << "\n";
   }
   if (transparent_line > 0)
-    std::cerr << "warning: " << path << ":" << transparent_line
-              << ": dissolve (d below 1 or Tr above 0) is not rendered, surfaces stay opaque; map_d cuts out\n";
+    stderr_text() << "warning: " << path << ":" << transparent_line
+                  << ": dissolve (d below 1 or Tr above 0) is not rendered, surfaces stay opaque; map_d cuts out\n";
   // A map_Kd without Kd shows the texture as it is (Kd multiplies the texture, as the MTL format says).
   for (size_t i = first; i < out.size(); i++)
     if (!out[i].kd_map.empty() && !has_kd[i - first]) out[i].material.kd = {1, 1, 1};
@@ -629,10 +629,10 @@ obj_clean_data validate_obj(const std::string& path) {
   int redefined = 0, undefined = 0, approximate = 0;
   for (size_t i = 0; i < st.defined.size(); i++)
     if (!defined_index.emplace(st.defined[i].material.name, int(i)).second && redefined++ < named_warnings)
-      std::cerr << "warning: " << st.defined[i].mtl_path << ":" << st.defined[i].line << ": material "
-                << quote(st.defined[i].material.name) << " is defined again; its first definition is used\n";
+      stderr_text() << "warning: " << st.defined[i].mtl_path << ":" << st.defined[i].line << ": material "
+                    << quote(st.defined[i].material.name) << " is defined again; its first definition is used\n";
   if (redefined > named_warnings)
-    std::cerr << "warning: " << redefined - named_warnings << " more materials are defined again\n";
+    stderr_text() << "warning: " << redefined - named_warnings << " more materials are defined again\n";
   // A name with a '#' word that matches nothing may have meant a comment after the name, on either side: "usemtl
   // wood #planks" and "newmtl red #red paint" (before, every '#' word started a comment): the names before the
   // '#' words are tried too, the used one against the defined ones, then against the defined ones' (first wins).
@@ -652,28 +652,28 @@ obj_clean_data validate_obj(const std::string& path) {
     if (!used_cut.empty()) lookup(defined_index, used_cut);
     lookup(short_index, used_cut.empty() ? st.used_names[k] : used_cut);
     if (found >= 0 && st.defined[size_t(found)].material.name != st.used_names[k] && approximate++ < named_warnings)
-      std::cerr << "warning: " << path << ":" << st.used_lines[k] << ": usemtl " << quote(st.used_names[k])
-                << " takes material " << quote(st.defined[size_t(found)].material.name)
-                << " (no exact match; the names agree before their '#' words)\n";
+      stderr_text() << "warning: " << path << ":" << st.used_lines[k] << ": usemtl " << quote(st.used_names[k])
+                    << " takes material " << quote(st.defined[size_t(found)].material.name)
+                    << " (no exact match; the names agree before their '#' words)\n";
     if (found >= 0) {
       d.materials.push_back(st.defined[size_t(found)]);
     } else {
       // As other OBJ readers do (tinyobjloader, Blender): the faces get the default material (Kd 0.8), said once per
       // name. OBJ files often outlive or lose their MTL's entries, or name materials with no mtllib at all.
       if (undefined++ < named_warnings)
-        std::cerr << "warning: " << path << ":" << st.used_lines[k] << ": usemtl of undefined material "
-                  << quote(st.used_names[k]) << (st.defined.empty() ? " (no material library defines any)" : "")
-                  << ": its faces get the default material (Kd 0.8)\n";
+        stderr_text() << "warning: " << path << ":" << st.used_lines[k] << ": usemtl of undefined material "
+                      << quote(st.used_names[k]) << (st.defined.empty() ? " (no material library defines any)" : "")
+                      << ": its faces get the default material (Kd 0.8)\n";
       d.materials.emplace_back();
       d.materials.back().material.name = st.used_names[k];
     }
   }
   if (approximate > named_warnings)
-    std::cerr << "warning: " << path << ": " << approximate - named_warnings
-              << " more usemtl names take a material whose name agrees before its '#' word\n";
+    stderr_text() << "warning: " << path << ": " << approximate - named_warnings
+                  << " more usemtl names take a material whose name agrees before its '#' word\n";
   if (undefined > named_warnings)
-    std::cerr << "warning: " << path << ": " << undefined - named_warnings
-              << " more undefined materials: their faces get the default material too\n";
+    stderr_text() << "warning: " << path << ": " << undefined - named_warnings
+                  << " more undefined materials: their faces get the default material too\n";
   return d;
 }
 

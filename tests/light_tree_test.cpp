@@ -341,6 +341,14 @@ TEST_CASE("a light tree built by parallel tasks does not depend on the thread co
   CHECK(same_column(t.right, one.right));
   CHECK(same_column(t.light, one.light));
   CHECK(same_column(t.left_prob, one.left_prob));
+  CHECK(same_column(t.center, one.center));
+  CHECK(same_column(t.radius, one.radius));
+  CHECK(same_column(t.parent, one.parent));
+  CHECK(same_column(t.color, one.color));
+  CHECK(same_column(t.leaf_of_light, one.leaf_of_light));
+  REQUIRE(t.packed.size() == one.packed.size());
+  CHECK(std::memcmp(t.packed.data(), one.packed.data(), t.packed.size() * sizeof(node_pack)) == 0);
+  CHECK(t.depth == one.depth);
 }
 
 TEST_CASE("a scene without emitters has an empty light tree", "[light_tree]") {

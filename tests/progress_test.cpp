@@ -1,5 +1,6 @@
 // Tests of the stderr notes for long phases without a progress bar (slow_phase_note): a line once the phase has run
 // long enough, nothing for a quick phase or when disabled, and no wait for the delay when the phase ends.
+#include "errors.h"
 #include "progress.h"
 
 #include <catch2/catch.hpp>
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <sstream>
 #include <thread>
 
 using namespace bl;
@@ -72,4 +74,34 @@ TEST_CASE("a quick phase, or a disabled note, writes nothing and ends without wa
     std::this_thread::sleep_for(50ms);
   }
   CHECK(cap.text().empty());
+}
+
+TEST_CASE("a note printed while warnings are written lands between them, never inside one", "[progress]") {
+  // Warnings written in pieces (as std::cerr << a << b does) let the note's line land between two pieces; stderr_text
+  // writes each at once. Many warnings while the note's delay runs out.
+  stderr_capture cap;
+  {
+    slow_phase_note note(true, "loading big.obj ...", 1ms);
+    for (int i = 0; i < 200000 && cap.text().find("loading") == std::string::npos; i++) {
+      stderr_text w;
+      w << "warning: big.obj:" << i << ":";
+      for (int k = 0; k < 40; k++) w << " part" << k;  // (40 writes each with std::cerr)
+      w << "\n";
+    }
+  }
+  std::istringstream lines(cap.text());
+  int notes = 0, warnings = 0;
+  for (std::string l; std::getline(lines, l);) {
+    INFO(l);
+    if (l == "loading big.obj ...") {
+      notes++;
+      continue;
+    }
+    warnings++;
+    CHECK(l.rfind("warning: big.obj:", 0) == 0);
+    CHECK(l.size() > 8);
+    CHECK(l.compare(l.size() - 7, 7, " part39") == 0);
+  }
+  CHECK(notes == 1);
+  CHECK(warnings > 0);
 }
