@@ -136,7 +136,7 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.frame_decay = o.frame_decay;
   p.pass_weighting = o.pass_weighting;
   p.stratify = !o.independent;
-  p.progress = !o.quiet && stderr_is_terminal();
+  p.progress = p.notes = !o.quiet && stderr_is_terminal();
   return p;
 }
 
@@ -263,7 +263,7 @@ int run_render(const render_options& o) {
       references.push_back(load_reference(frame_path(o.reference, f, animated), params));
   for (const image_data& r : references) params.frame_references.push_back(&r);
   auto t_load = std::chrono::steady_clock::now();
-  std::optional<slow_phase_note> loading(std::in_place, params.progress, "loading " + o.scene + " ...");
+  std::optional<slow_phase_note> loading(std::in_place, params.notes, "loading " + o.scene + " ...");
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
   report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
   {
@@ -620,8 +620,8 @@ int run_profile_command(const render_options& o) {
   warn_unused_options(o, {kind});
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
-  std::optional<slow_phase_note> loading(std::in_place, params.progress, "loading " + o.scene + " ...");
-  params.progress = false;
+  std::optional<slow_phase_note> loading(std::in_place, params.notes, "loading " + o.scene + " ...");
+  params.progress = false;  // (the timed stages must not share the machine with the bar; the notes stay)
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);

@@ -296,7 +296,7 @@ static void make_output_dir(const std::string& dir) {
 int run_compare(const scene_desc& desc, const compare_params& params) {
   const render_params& rp = params.render;
   image_data reference = read_reference(params.reference_path, rp.width, rp.height);
-  std::optional<slow_phase_note> loading(std::in_place, rp.progress, "loading " + desc.path + " ...");
+  std::optional<slow_phase_note> loading(std::in_place, rp.notes, "loading " + desc.path + " ...");
   scene_data scene = build_scene(desc, float(rp.width) / float(rp.height));
   report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
   {

@@ -341,7 +341,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   };
   std::optional<setup_scope> in_setup;
   in_setup.emplace();
-  std::optional<slow_phase_note> note(std::in_place, params.progress,
+  std::optional<slow_phase_note> note(std::in_place, params.notes,
                                       "setting up the light sampler (light tree, regions of the first hits) ...");
   light_tree_data tree;
   if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
@@ -365,7 +365,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     lp.reference = nullptr;
     lp.progress = false;
     render_result scratch;
-    note.emplace(params.progress, "learning the model of --bayes-oracle " + std::to_string(lp.spp) + " spp ...");
+    note.emplace(params.notes, "learning the model of --bayes-oracle " + std::to_string(lp.spp) + " spp ...");
     render_with(learn_in, *b, lp, scratch);
     note.reset();
     if (scratch.interrupted)

@@ -32,6 +32,7 @@ struct render_params {
   sampler_params sampler;
   const image_data* reference = nullptr;  // error is measured after every pass when set
   bool progress = false;      // progress bar on stderr
+  bool notes = false;         // slow_phase_note lines on stderr (set-up, oracle learning); profile: without the bar
   bool profile = false;       // time the hot path's stages (profile_timers.h) into render_result::profile_cycles
   int frames = 1;             // animation frames (the sun moves from sun.direction to sun.direction_end)
   double frame_decay = 0.5;   // learned statistics are scaled by this at the start of every frame after the first
