@@ -162,14 +162,19 @@ struct builder {
     build_bounds bins_of[3][bins];
     auto fill = [&](int axis) {
       float lo = cbox.lo[axis], hi = cbox.hi[axis];
-      if (!(hi > lo) || depth >= max_sah_depth) return;
+      if (!(hi > lo)) return;
       for (int i = b; i < e; i++) {
         int k = std::min(bins - 1, int(bins * ((items[size_t(i)].centroid[axis] - lo) / (hi - lo))));
         merge_into(bins_of[axis][k], items[size_t(i)].bounds);
       }
     };
-    if (e - b > parallel_items) tbb::parallel_invoke([&] { fill(0); }, [&] { fill(1); }, [&] { fill(2); });
-    else fill(0), fill(1), fill(2);
+    if (depth >= max_sah_depth) {
+      // median splits only (below): no bins
+    } else if (e - b > parallel_items) {
+      tbb::parallel_invoke([&] { fill(0); }, [&] { fill(1); }, [&] { fill(2); });
+    } else {
+      fill(0), fill(1), fill(2);
+    }
     for (int axis = 0; axis < 3 && depth < max_sah_depth; axis++) {
       float lo = cbox.lo[axis], hi = cbox.hi[axis];
       if (!(hi > lo)) continue;
