@@ -25,22 +25,30 @@ namespace {
 
 std::atomic<int> g_signal{0};
 std::atomic<int> g_signal_count{0};  // signals received (an output's wait ends on a new one)
-// Where the command stands, for a signal: while setting up (loading the scene; then, in the first render_frames, the
-// light tree, the sampler's regions and a checkpoint's state) nothing has been written yet, and a loader deep in a
-// large file would notice a request only once it is done, so the handler ends the process at once; afterwards it
-// asks the render to stop after its pass.
-enum phase : int { phase_none = 0, phase_setup = 1, phase_before_render = 2, phase_render = 3 };
+// Where the command stands, for a signal: while setting up (loading the scene, phase_setup; then, in the first
+// render_frames, the light tree, the sampler's regions and a checkpoint's state, phase_render_setup) nothing has been
+// written yet, and a loader deep in a large file would notice a request only once it is done, so the handler ends
+// the process at once; afterwards it asks the render to stop after its pass.
+enum phase : int { phase_none, phase_setup, phase_before_render, phase_render_setup, phase_render };
 std::atomic<int> g_phase{phase_none};
 
 extern "C" void on_interrupt(int sig) {
-  if (g_phase.load() == phase_setup) {
-    // Async-signal-safe: write(2) and _exit(2) only.
-    static const char term[] = "bayeslight: interrupted (SIGTERM) while loading the scene; nothing written\n";
-    static const char intr[] = "bayeslight: interrupted (SIGINT) while loading the scene; nothing written\n";
-    static const char hup[] = "bayeslight: interrupted (SIGHUP) while loading the scene; nothing written\n";
-    ssize_t ignored = sig == SIGTERM  ? write(2, term, sizeof term - 1)
-                      : sig == SIGHUP ? write(2, hup, sizeof hup - 1)
-                                      : write(2, intr, sizeof intr - 1);
+  int phase = g_phase.load();
+  if (phase == phase_setup || phase == phase_render_setup) {
+    // Async-signal-safe: write(2) and _exit(2) only, one write (a line another thread prints stays whole). The
+    // message names the phase: loading the scene, or the render's set-up (light tree, regions, a checkpoint's
+    // state), which takes seconds in a scene of many emitters.
+    static const char* const lines[2][3] = {
+        {"bayeslight: interrupted (SIGINT) while loading the scene; nothing written\n",
+         "bayeslight: interrupted (SIGTERM) while loading the scene; nothing written\n",
+         "bayeslight: interrupted (SIGHUP) while loading the scene; nothing written\n"},
+        {"bayeslight: interrupted (SIGINT) while setting up the render; nothing written\n",
+         "bayeslight: interrupted (SIGTERM) while setting up the render; nothing written\n",
+         "bayeslight: interrupted (SIGHUP) while setting up the render; nothing written\n"}};
+    const char* line = lines[phase == phase_setup ? 0 : 1][sig == SIGTERM ? 1 : sig == SIGHUP ? 2 : 0];
+    size_t len = 0;
+    while (line[len]) len++;
+    ssize_t ignored = write(2, line, len);
     (void)ignored;
     _exit(128 + sig);
   }
@@ -333,7 +341,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     bool active = false;
     setup_scope() {
       int expected = phase_before_render;
-      active = g_signal.load() == 0 && g_phase.compare_exchange_strong(expected, phase_setup);
+      active = g_signal.load() == 0 && g_phase.compare_exchange_strong(expected, phase_render_setup);
     }
     ~setup_scope() {
       if (active) g_phase.store(phase_render);

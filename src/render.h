@@ -105,7 +105,7 @@ image_data film_image(const render_result& r);
 // Installs SIGINT/SIGTERM handlers. Until interrupted_before_render is called (setting up: nothing written yet) a
 // signal ends the process at once with "interrupted (SIG...) while loading the scene; nothing written" and 128 +
 // signal; so it does again while the command's first render_frames sets up (light tree, regions, a checkpoint's
-// state); otherwise a signal requests the render to stop after the current pass.
+// state), saying "while setting up the render"; otherwise a signal requests the render to stop after the current pass.
 void install_interrupt_handlers();
 int interrupt_signal();
 // How many SIGINT/SIGTERM the handlers have received so far.

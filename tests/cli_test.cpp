@@ -1124,7 +1124,7 @@ TEST_CASE("a signal while the render sets up keeps the checkpoint and log alread
       auto r = run_bayeslight(base + " --spp 8 --stop-after-passes 0" + extra);
       INFO(sampler << extra << ": " << r.output);
       CHECK(r.status == 130);
-      CHECK(r.output.find("interrupted (SIGINT) while loading the scene; nothing written") != std::string::npos);
+      CHECK(r.output.find("interrupted (SIGINT) while setting up the render; nothing written") != std::string::npos);
       CHECK(read_text(ck) == ck_bytes);
       CHECK(read_text(log) == log_bytes);
       CHECK(read_text(out) == img_bytes);
