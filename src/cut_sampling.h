@@ -83,7 +83,7 @@ inline float cluster_bound(const light_tree_data& tree, const light_data& lights
 // Distance used by the regression for a cluster: to its box centre, clamped below by its radius (sun: 1).
 inline float cluster_distance(const light_tree_data& tree, int node, vec3f p) {
   if (node == sun_cluster) return 1;
-  return std::max(length(p - tree.center[size_t(node)]), tree.radius[size_t(node)]);
+  return std::max(length(p - node_center(tree, node)), node_radius(tree, node));
 }
 
 // Normalises non-negative weights (in cut order, positive ones floored as in fill_cdf) into ctx.cdf; false when

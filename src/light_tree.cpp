@@ -142,12 +142,11 @@ struct builder {
     size_t i = size_t(node);
     t.lo[i] = bb.box.lo;
     t.hi[i] = bb.box.hi;
-    t.center[i] = center(bb.box);
-    t.radius[i] = 0.5f * diagonal(bb.box);
-    t.axis[i] = bb.cone.axis;
-    t.cos_o[i] = bb.cone.cos_t;  // (make_cone's: cos and sin of theta, -1 and 0 at pi)
-    t.sin_o[i] = bb.cone.sin_t;
-    t.intensity[i] = bb.intensity;
+    vec3f c = center(bb.box);
+    vec3f a = bb.cone.axis;
+    // (make_cone's cosine and sine of theta: -1 and 0 at pi)
+    t.packed[i] = {c.x, c.y, c.z, 0.5f * diagonal(bb.box), a.x, a.y, a.z, bb.cone.cos_t, bb.cone.sin_t, bb.intensity,
+                   0, 0};
   }
 
   // Chooses the split of items [b, e) and partitions them; returns the first index of the right half.
@@ -252,22 +251,14 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
   size_t nodes = size_t(2 * n - 1);
   t.lo.resize(nodes);
   t.hi.resize(nodes);
-  t.center.resize(nodes);
-  t.radius.resize(nodes);
-  t.axis.resize(nodes);
-  t.cos_o.resize(nodes);
-  t.sin_o.resize(nodes);
-  t.intensity.resize(nodes);
+  t.packed.resize(nodes);
   t.left.assign(nodes, invalid_id);
   t.right.assign(nodes, invalid_id);
   t.parent.assign(nodes, invalid_id);
   t.light.assign(nodes, invalid_id);
   builder bld{t, items};
   t.depth = bld.build(0, n, 0, invalid_id, 0);
-  t.packed.resize(nodes);
-  for (size_t i = 0; i < nodes; i++)
-    t.packed[i] = {t.center[i].x, t.center[i].y, t.center[i].z, t.radius[i], t.axis[i].x, t.axis[i].y, t.axis[i].z,
-                   t.cos_o[i],    t.sin_o[i],    t.intensity[i], 0,           0};
+  std::vector<build_item>().swap(items);  // (the peak of a large build: not held with the colour pass's arrays)
   // Emission colour per node: RGB intensity over luminance intensity (children before parents, by an explicit
   // post-order walk), white where a node emits nothing.
   std::vector<vec3f> rgb(nodes, vec3f{0, 0, 0});
@@ -297,18 +288,18 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
   // Descent probabilities once per node (the same double expression the descent used to evaluate per visit).
   t.left_prob.assign(nodes, 0.0);
   for (size_t i = 0; i < nodes; i++)
-    if (t.light[i] == invalid_id) t.left_prob[i] = left_share(t.intensity[size_t(t.left[i])], t.intensity[size_t(t.right[i])]);
+    if (t.light[i] == invalid_id)
+      t.left_prob[i] = left_share(node_intensity(t, t.left[i]), node_intensity(t, t.right[i]));
   return t;
 }
 
 // Emitter cos bound of a node over the directions between its bounding sphere and the box's.
 static float emitter_cos_toward_box(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
-  size_t i = size_t(node);
   vec3f cb = (lo + hi) * 0.5f;
   float rb = 0.5f * length(hi - lo);
-  vec3f to_b = cb - t.center[i];
+  vec3f to_b = cb - node_center(t, node);
   float d = length(to_b);
-  float r = rb + t.radius[i];
+  float r = rb + node_radius(t, node);
   float sin_b = 0, cos_b = -1;
   if (d > r) {
     sin_b = r / d;
@@ -319,7 +310,7 @@ static float emitter_cos_toward_box(const light_tree_data& t, int node, vec3f lo
 }
 
 float node_region_intensity(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
-  return t.intensity[size_t(node)] * emitter_cos_toward_box(t, node, lo, hi);
+  return node_intensity(t, node) * emitter_cos_toward_box(t, node, lo, hi);
 }
 
 float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi) {
@@ -328,7 +319,7 @@ float node_region_bound(const light_tree_data& t, int node, vec3f lo, vec3f hi) 
   float ce = emitter_cos_toward_box(t, node, lo, hi);
   if (ce == 0) return 0;
   float d2 = box_distance_sq(lo, hi, t.lo[i], t.hi[i]);
-  return t.intensity[i] * ce / std::max(d2, rb * rb);
+  return node_intensity(t, node) * ce / std::max(d2, rb * rb);
 }
 
 // Probability of taking the left child of an interior node when descending by intensity.

@@ -17,7 +17,10 @@ namespace bl {
 constexpr int max_sah_depth = 64;
 constexpr int max_tree_depth = 104;
 
-// Per node, the 12 floats an importance evaluation reads, packed so that one node is one gather.
+// Per node, the 12 floats an importance evaluation reads, packed so that one node is one gather: the box centre,
+// half the box diagonal, the normal cone's unit axis and the cosine and sine of its half-angle theta_o (-1 and 0
+// at theta_o = pi: any normal), and the intensity (sum of luminance(Le) * area of the node's emitters). The only
+// copy of these values (read them through the node_* accessors below).
 struct node_pack {
   float cx, cy, cz, r, ax, ay, az, cos_o, sin_o, intensity, pad0, pad1;
 };
@@ -25,21 +28,29 @@ struct node_pack {
 // The tree as flat columns indexed by node id.
 struct light_tree_data {
   std::vector<vec3f> lo, hi;          // bounding box
-  std::vector<vec3f> center;          // box centre
-  std::vector<float> radius;          // half the box diagonal
-  std::vector<vec3f> axis;            // normal cone axis (unit)
-  std::vector<float> cos_o, sin_o;    // normal cone half-angle theta_o (theta_o = pi: any normal)
-  std::vector<float> intensity;       // sum of luminance(Le) * area of the node's emitters
+  std::vector<node_pack> packed;      // centre, radius, normal cone, intensity (see node_pack)
   std::vector<int> left, right;       // children (invalid_id for leaves)
   std::vector<int> parent;
   std::vector<int> light;             // leaf: its light id; interior: invalid_id
   std::vector<int> leaf_of_light;     // per triangle light id: its leaf node
-  std::vector<node_pack> packed;      // the columns importance reads, one record per node
   std::vector<double> left_prob;      // interior: probability of the left child when descending by intensity
   std::vector<vec3f> color;           // emission colour: RGB intensity / luminance intensity (luminance 1)
   bool two_sided = false;
   int depth = 0;                      // longest root-to-leaf path (edges)
 };
+
+inline vec3f node_center(const light_tree_data& t, int node) {
+  const node_pack& q = t.packed[size_t(node)];
+  return {q.cx, q.cy, q.cz};
+}
+inline float node_radius(const light_tree_data& t, int node) { return t.packed[size_t(node)].r; }
+inline vec3f node_axis(const light_tree_data& t, int node) {
+  const node_pack& q = t.packed[size_t(node)];
+  return {q.ax, q.ay, q.az};
+}
+inline float node_cos_o(const light_tree_data& t, int node) { return t.packed[size_t(node)].cos_o; }
+inline float node_sin_o(const light_tree_data& t, int node) { return t.packed[size_t(node)].sin_o; }
+inline float node_intensity(const light_tree_data& t, int node) { return t.packed[size_t(node)].intensity; }
 
 inline int node_count(const light_tree_data& t) { return int(t.light.size()); }
 inline bool is_leaf(const light_tree_data& t, int node) { return t.light[size_t(node)] != invalid_id; }
@@ -59,10 +70,11 @@ inline float sin_sub_clamped(float sin_a, float cos_a, float sin_b, float cos_b)
 // direction within half-angle theta_b (given by sin_b, cos_b) of the unit direction w from the node's centre
 // to the receiver. Zero when no emitter of the node can face any such receiver.
 inline float node_emitter_cos_bound(const light_tree_data& t, int node, vec3f w, float sin_b, float cos_b) {
-  float cos_w = dot(t.axis[size_t(node)], w);
+  const node_pack& q = t.packed[size_t(node)];
+  float cos_w = dot(vec3f{q.ax, q.ay, q.az}, w);
   if (t.two_sided) cos_w = std::fabs(cos_w);
   float sin_w = safe_sqrt(1 - cos_w * cos_w);
-  float co = t.cos_o[size_t(node)], so = t.sin_o[size_t(node)];
+  float co = q.cos_o, so = q.sin_o;
   float cos_wo = cos_sub_clamped(sin_w, cos_w, so, co);
   float sin_wo = sin_sub_clamped(sin_w, cos_w, so, co);
   float c = cos_sub_clamped(sin_wo, cos_wo, sin_b, cos_b);
@@ -83,10 +95,10 @@ inline float receiver_cos_bound(vec3f n, vec3f w_to, float sin_b, float cos_b) {
 // the box radius (Conty-Kulla / pbrt-v4 style). Zero only when the node provably cannot light the point.
 // Returned in two parts: the distance-free numerator, and inv_d2 = 1 / d^2 (the regression's distance term).
 inline float node_importance_parts(const light_tree_data& t, int node, vec3f p, vec3f n, float& inv_d2) {
-  size_t i = size_t(node);
-  vec3f to_p = p - t.center[i];
+  const node_pack& q = t.packed[size_t(node)];
+  vec3f to_p = p - vec3f{q.cx, q.cy, q.cz};
   float d2 = length_sq(to_p);
-  float r = t.radius[i];
+  float r = q.r;
   inv_d2 = 1 / std::max(d2, r * r);
   float d = std::sqrt(d2);
   // Angle subtended by the node's bounding sphere seen from p (theta_b = pi inside it).
@@ -99,7 +111,7 @@ inline float node_importance_parts(const light_tree_data& t, int node, vec3f p, 
   float ce = node_emitter_cos_bound(t, node, w, sin_b, cos_b);
   if (ce == 0) return 0;
   float cr = receiver_cos_bound(n, -w, sin_b, cos_b);
-  return t.intensity[i] * ce * cr;
+  return q.intensity * ce * cr;
 }
 inline float node_importance(const light_tree_data& t, int node, vec3f p, vec3f n) {
   float inv_d2;

@@ -393,10 +393,10 @@ int add_regions(region_state& s, const light_tree_data& tree, const std::vector<
 // not change sampling much): its radius is small against its gap to the box and its normals agree.
 static bool coherent_node(const light_tree_data& tree, int node, const bbox3f& box, float coherence) {
   constexpr float cos_30 = 0.8660254f;
-  size_t i = size_t(node);
-  if (tree.cos_o[i] < cos_30) return false;
-  float gap = length(center(box) - tree.center[i]) - 0.5f * diagonal(box) - tree.radius[i];
-  return gap > 0 && tree.radius[i] <= coherence * gap;
+  if (node_cos_o(tree, node) < cos_30) return false;
+  float r = node_radius(tree, node);
+  float gap = length(center(box) - node_center(tree, node)) - 0.5f * diagonal(box) - r;
+  return gap > 0 && r <= coherence * gap;
 }
 
 std::vector<int> compute_light_cut(const light_tree_data& tree, bbox3f box, bool has_sun, const region_params& p) {

@@ -232,8 +232,8 @@ double orientation_of(const test_scene& t, const bayes_sampler& s, int node, vec
   if (node == sun_cluster) {
     o = receiver_cos_bound(n, t.lights.sun_dir, s.sun_sin, s.sun_cos);
   } else {
-    vec3f c = t.tree.center[size_t(node)];
-    double r = t.tree.radius[size_t(node)];
+    vec3f c = node_center(t.tree, node);
+    double r = node_radius(t.tree, node);
     double dn = double(n.x) * (p.x - c.x) + double(n.y) * (p.y - c.y) + double(n.z) * (p.z - c.z);
     o = (r - dn) / std::sqrt(double(length_sq(p - c)));
   }
@@ -453,8 +453,8 @@ TEST_CASE("with the region prior a bayes sampler without data weighs clusters by
           front = dot(n, t->lights.sun_dir) > -sy.sun_sin;
         } else {
           mu0 = node_region_intensity(t->tree, node, box.lo, box.hi);
-          vec3f c = t->tree.center[size_t(node)];
-          double r = t->tree.radius[size_t(node)];
+          vec3f c = node_center(t->tree, node);
+          double r = node_radius(t->tree, node);
           g = 1 / std::max(double(length_sq(p - c)), r * r);
           front = dot(n, c - p) > -r;
         }

@@ -251,8 +251,8 @@ TEST_CASE("light tree structure holds its invariants on random light sets", "[li
     // Boxes nest, centres and radii describe the boxes, intensities add up.
     for (int i = 0; i < node_count(t); i++) {
       size_t k = size_t(i);
-      CHECK(same_bits(t.center[k], (t.lo[k] + t.hi[k]) * 0.5f));
-      CHECK(t.radius[k] == Approx(0.5 * length(t.hi[k] - t.lo[k])).epsilon(1e-6));
+      CHECK(same_bits(node_center(t, i), (t.lo[k] + t.hi[k]) * 0.5f));
+      CHECK(node_radius(t, i) == Approx(0.5 * length(t.hi[k] - t.lo[k])).epsilon(1e-6));
       if (is_leaf(t, i)) {
         int l = t.light[k];
         vec3f c[3];
@@ -263,7 +263,7 @@ TEST_CASE("light tree structure holds its invariants on random light sets", "[li
             CHECK(t.hi[k][a] >= v[a]);
           }
         int tri = s.lights.tri[size_t(l)];
-        CHECK(same_bits(t.intensity[k], luminance(s.lights.radiance[size_t(l)]) * s.scene.tri_area[size_t(tri)]));
+        CHECK(same_bits(node_intensity(t, i), luminance(s.lights.radiance[size_t(l)]) * s.scene.tri_area[size_t(tri)]));
         continue;
       }
       for (int c : {t.left[k], t.right[k]}) {
@@ -272,21 +272,20 @@ TEST_CASE("light tree structure holds its invariants on random light sets", "[li
           CHECK(t.hi[k][a] >= t.hi[size_t(c)][a]);
         }
       }
-      double sum = double(t.intensity[size_t(t.left[k])]) + double(t.intensity[size_t(t.right[k])]);
-      CHECK(std::fabs(double(t.intensity[k]) - sum) <= 1e-5 * sum);
+      double sum = double(node_intensity(t, t.left[k])) + double(node_intensity(t, t.right[k]));
+      CHECK(std::fabs(double(node_intensity(t, i)) - sum) <= 1e-5 * sum);
     }
     // The normal cone of every node contains the normals of all its emitters.
     for (int i = 0; i < node_count(t); i++) {
-      size_t k = size_t(i);
-      CHECK(std::fabs(t.cos_o[k] * t.cos_o[k] + t.sin_o[k] * t.sin_o[k] - 1) < 1e-5f);
-      CHECK(std::fabs(length(t.axis[k]) - 1) < 1e-5f);
-      if (t.cos_o[k] == -1) continue;  // theta_o = pi: any normal
-      double theta_o = std::atan2(double(t.sin_o[k]), double(t.cos_o[k]));
+      CHECK(std::fabs(node_cos_o(t, i) * node_cos_o(t, i) + node_sin_o(t, i) * node_sin_o(t, i) - 1) < 1e-5f);
+      CHECK(std::fabs(length(node_axis(t, i)) - 1) < 1e-5f);
+      if (node_cos_o(t, i) == -1) continue;  // theta_o = pi: any normal
+      double theta_o = std::atan2(double(node_sin_o(t, i)), double(node_cos_o(t, i)));
       std::vector<int> leaves;
       leaves_under(t, i, leaves);
       for (int leaf : leaves) {
         vec3f ng = s.scene.tri_ng[size_t(s.lights.tri[size_t(t.light[size_t(leaf)])])];
-        double ang = angle_between(t.axis[k], ng);
+        double ang = angle_between(node_axis(t, i), ng);
         INFO("node " << i << " leaf " << leaf << " angle " << ang << " theta_o " << theta_o);
         CHECK(ang <= theta_o + 1e-4);
       }
@@ -305,17 +304,13 @@ TEST_CASE("light tree structure holds its invariants on random light sets", "[li
     light_tree_data t2 = build_light_tree(s.lights, s.scene);
     CHECK(same_column(t.lo, t2.lo));
     CHECK(same_column(t.hi, t2.hi));
-    CHECK(same_column(t.center, t2.center));
-    CHECK(same_column(t.radius, t2.radius));
-    CHECK(same_column(t.axis, t2.axis));
-    CHECK(same_column(t.cos_o, t2.cos_o));
-    CHECK(same_column(t.sin_o, t2.sin_o));
-    CHECK(same_column(t.intensity, t2.intensity));
     CHECK(same_column(t.left, t2.left));
     CHECK(same_column(t.right, t2.right));
     CHECK(same_column(t.parent, t2.parent));
     CHECK(same_column(t.light, t2.light));
     CHECK(same_column(t.leaf_of_light, t2.leaf_of_light));
+    REQUIRE(t.packed.size() == t2.packed.size());
+    CHECK(std::memcmp(t.packed.data(), t2.packed.data(), t.packed.size() * sizeof(node_pack)) == 0);
     CHECK(t.depth == t2.depth);
   }
 }
@@ -333,16 +328,10 @@ TEST_CASE("a light tree built by parallel tasks does not depend on the thread co
   REQUIRE(node_count(one) == node_count(t));
   CHECK(same_column(t.lo, one.lo));
   CHECK(same_column(t.hi, one.hi));
-  CHECK(same_column(t.axis, one.axis));
-  CHECK(same_column(t.cos_o, one.cos_o));
-  CHECK(same_column(t.sin_o, one.sin_o));
-  CHECK(same_column(t.intensity, one.intensity));
   CHECK(same_column(t.left, one.left));
   CHECK(same_column(t.right, one.right));
   CHECK(same_column(t.light, one.light));
   CHECK(same_column(t.left_prob, one.left_prob));
-  CHECK(same_column(t.center, one.center));
-  CHECK(same_column(t.radius, one.radius));
   CHECK(same_column(t.parent, one.parent));
   CHECK(same_column(t.color, one.color));
   CHECK(same_column(t.leaf_of_light, one.leaf_of_light));
@@ -389,14 +378,14 @@ TEST_CASE("intensity descent samples leaves with the probability its pmf states"
         double pmf = intensity_descent_pmf(t, start, leaves[j]);
         CHECK(pmf >= 0);
         // Unbiasedness inside a cluster: a light with positive intensity keeps a positive probability.
-        if (t.intensity[size_t(leaves[j])] > 0 && !(pmf > 0)) {
+        if (node_intensity(t, leaves[j]) > 0 && !(pmf > 0)) {
           starved++;
           if (starved <= 3)
             which += " leaf " + std::to_string(leaves[j]) + " (intensity " +
-                     sci(t.intensity[size_t(leaves[j])]) + ", sibling " +
-                     sci(t.intensity[size_t(t.left[size_t(t.parent[size_t(leaves[j])])] == leaves[j]
-                                                           ? t.right[size_t(t.parent[size_t(leaves[j])])]
-                                                           : t.left[size_t(t.parent[size_t(leaves[j])])])]) +
+                     sci(node_intensity(t, leaves[j])) + ", sibling " +
+                     sci(node_intensity(t, t.left[size_t(t.parent[size_t(leaves[j])])] == leaves[j]
+                                               ? t.right[size_t(t.parent[size_t(leaves[j])])]
+                                               : t.left[size_t(t.parent[size_t(leaves[j])])])) +
                      ")";
         }
         exp[j] = samples * double(pmf);
