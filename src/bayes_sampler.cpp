@@ -533,13 +533,14 @@ void bayes_sampler::add_pairs(int first_region) {
   resize_stats(stats, regions.pairs, params);
   // Children lists of the coarse pairs (refold reaches a coarse pair's children through them).
   size_t npairs = stats.m.size();
-  if (first_region == 0) child_link.clear();
+  if (first_region == 0) child_link.clear(), parent_pairs = 0;
   child_link.resize(npairs, invalid_id);
   for (size_t r = size_t(first_region); r < regions.key.size(); r++) {
     size_t b = size_t(regions.pair_offset[r]), e = b + size_t(regions.pair_count[r]);
     for (size_t k = b; k < e; k++) {
       int up = regions.pair_parent[k];
       if (up == invalid_id) continue;
+      if (child_link[size_t(up)] == invalid_id) parent_pairs++;
       child_link[k] = child_link[size_t(up)];
       child_link[size_t(up)] = int(k);
     }
@@ -572,6 +573,28 @@ void bayes_sampler::add_pairs(int first_region) {
       }
     }
   });
+}
+
+void bayes_sampler::reserve_growth() {
+  // Fine pairs stay within the budget, coarse pairs within as many again (region_grid's allowance).
+  const size_t now = size_t(regions.pairs), cuts = regions.cut_nodes.size();
+  const size_t most = now + 2 * size_t(std::max<int64_t>(regions.params.max_pairs, 0));
+  const size_t pairs = std::min(2 * now, most), entries = std::min(2 * cuts, most);
+  for (std::vector<float>* v : {&stats.mu0, &stats.p1_folded, &stats.k_folded}) v->reserve(pairs);
+  for (std::vector<float>* v : {&stats.w, &stats.w_cv, &stats.cv}) v->reserve(pairs + 4);
+  stats.m.reserve(pairs);
+  if (!params.region_prior) stats.weight.reserve(pairs);
+  stats.scratch.seen.reserve(pairs);
+  stats.scratch.dirty.reserve(pairs);
+  child_link.reserve(pairs);
+  for (std::vector<int>* v : {&regions.pair_node, &regions.pair_slot, &regions.pair_parent}) v->reserve(pairs);
+  regions.cut_nodes.reserve(entries);
+  regions.member_begin.reserve(entries);
+  if (!regions.members) return;
+  for (std::vector<float>* v : {&stats.gw, &stats.gw_cv, &stats.gcv}) v->reserve(entries + 4);
+  stats.gcol.reserve(entries);
+  stats.gtot.reserve(entries);
+  stats.gtot_cv.reserve(entries);
 }
 
 void bayes_sampler::rebuild_posterior() {
@@ -665,8 +688,52 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
     }
     folds.fetch_add(int64_t(g.size()), std::memory_order_relaxed);
   });
-  // Children of the moved pairs (each child has one parent: no pair is folded by two tasks).
-  if (hier)
+  // Children of the moved pairs (each child has one parent: no pair is folded by two tasks). A child is refolded when
+  // its parent's mean moved and its bound lies above the lower of the parent's two means (`low`), or when its own
+  // p1 moved by more than the tolerance.
+  auto child_moved = [&](size_t c, size_t up, uint8_t flags, float low) {
+    return ((flags & mean_moved) && stats.mu0[c] > low) ||
+           ((flags & p1_moved) && moved_by(pair_p1(stats, c, int(up), params), stats.p1_folded[c]));
+  };
+  // The parent's `low`, and its mean as its children are examined now.
+  auto examine_parent = [&](size_t k, uint8_t flags) {
+    float low = 0;
+    if (flags & mean_moved) {
+      float now = float(own_posterior_mean(stats, k, params));
+      low = std::min(now, stats.k_folded[k]);
+      stats.k_folded[k] = now;
+    }
+    return low;
+  };
+  size_t moved_parents = 0, parents = 0;
+  if (hier) {
+    for (int k : touched) moved_parents += moved[size_t(k)] != 0;
+    parents = parent_pairs;
+  }
+  // Where many parents moved (the first passes: every coarse pair is learning), nearly every fine pair is examined:
+  // one sequential scan of the pairs then beats walking each parent's list of children, which are scattered over
+  // the fine regions (a cache miss per child). The same children are refolded either way, with the same inputs.
+  const bool scan = hier && moved_parents * 16 > parents;
+  if (scan) {
+    std::vector<float>& low_of = stats.scratch.low;
+    if (low_of.size() < moved.size()) low_of.resize(moved.size());
+    for (int k : touched)
+      if (moved[size_t(k)]) low_of[size_t(k)] = examine_parent(size_t(k), moved[size_t(k)]);
+    const std::vector<int>& parent = regions.pair_parent;
+    const size_t flagged = moved.size();  // parents created this pass (not touched) never moved
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs, 4096), [&](const tbb::blocked_range<size_t>& g) {
+      int64_t count = 0;
+      for (size_t c = g.begin(); c < g.end(); c++) {
+        int up = parent[c];
+        if (up == invalid_id || size_t(up) >= flagged) continue;
+        uint8_t flags = moved[size_t(up)];
+        if (!flags || !child_moved(c, size_t(up), flags, low_of[size_t(up)])) continue;
+        fold(c), count++;  // (members: every cluster is summed again below; no list)
+      }
+      folds.fetch_add(count, std::memory_order_relaxed);
+    });
+    for (int k : touched) moved[size_t(k)] = 0;
+  } else if (hier) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& g) {
       int64_t count = 0;
       for (size_t t = g.begin(); t < g.end(); t++) {
@@ -674,23 +741,25 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
         uint8_t flags = moved[size_t(k)];
         if (!flags) continue;
         moved[size_t(k)] = 0;
-        float low = 0;  // children whose bound lies above it may change their prior mean
-        if (flags & mean_moved) {
-          float now = float(own_posterior_mean(stats, size_t(k), params));
-          low = std::min(now, stats.k_folded[size_t(k)]);
-          stats.k_folded[size_t(k)] = now;
-        }
+        float low = examine_parent(size_t(k), flags);
         for (int c = child_link[size_t(k)]; c != invalid_id; c = child_link[size_t(c)])
-          if (((flags & mean_moved) && stats.mu0[size_t(c)] > low) ||
-              ((flags & p1_moved) && moved_by(pair_p1(stats, size_t(c), k, params), stats.p1_folded[size_t(c)]))) {
+          if (child_moved(size_t(c), size_t(k), flags, low)) {
             if (regions.members && !dirty[size_t(c)]) children.local().push_back(c);  // not listed yet
             fold(size_t(c)), count++;
           }
       }
       folds.fetch_add(count, std::memory_order_relaxed);
     });
+  }
   timing.refolds += double(folds.load());
   if (!regions.members) return;
+  if (scan) {
+    // Most pairs were refolded: every cluster sums its members again (a cluster none of whose members changed gets
+    // the sum it holds), in one sweep over the regions instead of a list of the refolded pairs.
+    refresh_groups(nullptr);
+    std::fill(dirty.begin(), dirty.end(), uint8_t(0));
+    return;
+  }
   // The clusters of every refolded pair (listed once each) sum their members' weights again.
   std::vector<int> folded(touched);
   for (size_t i = old_pairs; i < pairs; i++) folded.push_back(int(i));

@@ -33,6 +33,7 @@ struct bayes_sampler {
   // Per pair: the fine pairs of a coarse pair as a linked list: a coarse pair's first child, a fine pair's next
   // sibling (two levels: a coarse pair has no siblings, a fine one no children); invalid_id ends the list.
   std::vector<int> child_link;
+  size_t parent_pairs = 0;  // pairs with a list of children (coarse pairs whose fine regions exist)
 
   // Fallback (bayes_params::fallback_ratio): once on, lights are chosen by power and nothing more is learned.
   power_sampler power;
@@ -108,6 +109,10 @@ struct bayes_sampler {
   // Sizes the statistics for every region and sets the region-level prior means of the pairs of regions
   // [first_region, end) (a function of each region's box and cut only). Weights are refolded by the caller.
   void add_pairs(int first_region);
+  // Reserves the columns for the pairs and cut entries of the regions, and room for what passes may add (up to as
+  // many again, within the pair budget): growing a column copies it and touches its new pages, a pause of tenths of
+  // a second for the million pairs of a scene with many lights. Reserved pages that are never written take no memory.
+  void reserve_growth();
   // Refolds the weights of the pairs whose inputs changed in a pass: the touched pairs, the pairs new since
   // `old_pairs`, and the children of coarse pairs whose p1 moved by more than the refold tolerance. Work scales
   // with the pass's records, not with the pairs.

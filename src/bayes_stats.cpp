@@ -14,6 +14,7 @@ namespace bl {
 
 void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   size_t old = s.m.size(), n = size_t(pairs);
+  s.empty = pair_coefficients(pair_moments{}, p);
   s.m.resize(n);
   s.weight.resize(p.region_prior ? 0 : n);
   s.mu0.resize(n, 0.0f);

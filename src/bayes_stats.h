@@ -110,6 +110,7 @@ struct merge_buffers {
   std::vector<std::vector<int>> touched;       // per bucket: the pairs it updated
   std::vector<uint8_t> seen;                   // per pair: already in a touched list (all zero between calls)
   std::vector<uint8_t> dirty;                  // per pair: refolded in this refold (members; all zero between calls)
+  std::vector<float> low;                      // refold's scan of children: per moved parent, the lower of its means
 };
 
 struct bayes_stats {
@@ -131,6 +132,7 @@ struct bayes_stats {
   std::vector<vec3f> gcol;               // members, per cut entry: the sum of its members' colour times cv (a point's
                                          // control-variate total adds it times the cluster's point factor)
   merge_buffers scratch;
+  pair_coeffs empty = {};  // pair_coefficients of a pair without samples (set by resize_stats from the parameters)
 };
 
 // The posterior point estimates of pair i for prior mean mu0: k (mean of z) and h (variance of z); false when the
@@ -178,7 +180,11 @@ inline double prior_mean(const bayes_stats& s, size_t i, int up, const bayes_par
 }
 // Pair i's coefficients with p1 folded in: what a shading point evaluates in point-prior mode.
 inline pair_weight folded_coeffs(const bayes_stats& s, size_t i, double p1, const bayes_params& p) {
-  const pair_coeffs c = pair_coefficients(s.m[i], p);
+  const pair_moments& m = s.m[i];
+  // Most fine pairs have no samples of their own in a render's first passes (their weights follow their parents'):
+  // their coefficients are the same constants.
+  const bool none = m.n0 == 0 && m.n1 == 0 && m.mean == 0 && m.m2 == 0;
+  const pair_coeffs c = none ? s.empty : pair_coefficients(m, p);
   return {float(p1 * c.q2), float(p1 * c.q1), float(p1 * c.q0), float(p1 * c.qc)};
 }
 // Folds pair i's p1 (and, under the mean hierarchy, its parent's mean) into its sampling weight.

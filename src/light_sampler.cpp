@@ -138,6 +138,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
         s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);
       s.regions = make_regions(params, in, tree, true, s.params.region_prior);
+      s.reserve_growth();
       s.add_pairs(0);
       refresh_weights(s.stats, &s.regions.pair_parent, s.params);
       s.refresh_groups(nullptr);
