@@ -581,7 +581,7 @@ void bayes_sampler::reserve_growth() {
   // Fine pairs stay within the budget, coarse pairs within as many again (region_grid's allowance).
   const size_t now = size_t(regions.pairs), cuts = regions.cut_nodes.size();
   const size_t most = now + 2 * size_t(std::max<int64_t>(regions.params.max_pairs, 0));
-  const size_t pairs = std::min(2 * now, most), entries = std::min(2 * cuts, most);
+  const size_t pairs = std::min(now + now / 2, most), entries = std::min(cuts + cuts / 2, most);
   for (std::vector<float>* v : {&stats.mu0, &stats.p1_folded, &stats.k_folded}) v->reserve(pairs);
   for (std::vector<float>* v : {&stats.w, &stats.w_cv, &stats.cv}) v->reserve(pairs + 4);
   stats.m.reserve(pairs);
