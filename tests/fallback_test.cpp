@@ -1,8 +1,9 @@
 // The bayes sampler's fallback to power sampling (bayes_params::fallback_ratio): the check's sums against values
 // worked out by hand (the per-pixel variance of a pass's samples, pairs of one-spp passes, the NEE events' change
 // of second moment under power sampling), its decision rule (two checked passes in a row below the threshold, or one
-// below half of it, from 4 spp on, windows of enough samples), and through the binary: it falls back where learning cannot pay (the Cornell box, path traced) and not
-// where it does (the plant room), the image stays unbiased and deterministic, and a resumed render is identical.
+// below half of it, from 4 spp on, windows of enough samples), and through the binary: it falls back where learning
+// cannot pay (the Cornell box) and not where it does (the plant room), the image stays unbiased and deterministic,
+// and a resumed render is identical.
 #include "bayes_sampler.h"
 #include "file_io.h"
 #include "test_util.h"
