@@ -504,9 +504,7 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     bool below = valid && window_var + window_delta < threshold * window_var;
     fallback_votes = below ? fallback_votes + 1 : 0;
     window_var = window_delta = window_samples = 0;
-    // Two windows in a row below the threshold, or one below half of it (the estimate says learning gains nothing:
-    // the Cornell boxes estimate 1.03-1.09 against the threshold of 2.5, the occluded scenes 24 and more).
-    fallback = fallback_votes >= 2 || (valid && check_ratio < 0.5 * threshold);
+    fallback = fallback_votes >= 2;
     if (fallback) fallback_spp = spp;
     check_done = valid && check_ratio >= 2 * threshold;
     if (fallback || check_done) {

@@ -86,11 +86,11 @@ struct bayes_sampler {
   void sample_done(row_state& row, int pixel, vec3f l) const;
   // Between passes, before learn: the pass's estimated relMSE ratio of power sampling over the learned sampler
   // (pixel weights from `film`, sum_i w_i x_i over `weight` in RGB, which includes the pass); falls back when it was
-  // below the threshold in two check windows in a row, or below half of it in one. Checked: passes that end at 4 spp
-  // or more, of two spp or more (a pixel's variance from its own samples) or of one spp after one (from the pair); a
-  // window sums checked passes until they hold bayes_params::fallback_window samples. A window whose ratio is at
-  // least twice the threshold ends the checks (learning pays; it only improves). `pass_spp`: the pass's spp, `spp`:
-  // the total after it. The check's columns are sized for the film's pixels.
+  // below the threshold in two check windows in a row. Checked: passes that end at 4 spp or more, of two spp or more
+  // (a pixel's variance from its own samples) or of one spp after one (from the pair); a window sums checked passes
+  // until they hold bayes_params::fallback_window samples. A window whose ratio is at least twice the threshold ends
+  // the checks (learning pays; it only improves). `pass_spp`: the pass's spp, `spp`: the total after it.
+  // The check's columns are sized for the film's pixels.
   void check_fallback(const std::vector<row_state>& rows, const std::vector<double>& film, double weight,
                       int pass_spp, int spp);
   // Control variates (prepare set ctx.cv): the emission colour of cluster j (luminance 1), the colour-weighted sum

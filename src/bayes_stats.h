@@ -52,9 +52,8 @@ struct bayes_params {
                                  // its fine regions), so a new fine region starts from what its surroundings learned
   double fallback_ratio = 1.25;  // fall back to power sampling for the rest of the render when the estimated relMSE
                                  // per sample of power sampling is below this many times the learned one's in two
-                                 // check windows in a row, or half as many in one (from 4 spp on): where learning
-                                 // cannot pay for its own cost (bayes costs 1.4-2.6x power's time per sample on the
-                                 // data/ scenes); 0: never
+                                 // check windows in a row (from 4 spp on): where learning cannot pay for its own
+                                 // cost (bayes costs 1.4-2.6x power's time per sample on the data/ scenes); 0: never
   double fallback_stratified = 2;  // the threshold's factor when the first vertex is stratified (the default): the
                                    // check estimates both sides as if samples were independent, but stratification
                                    // helps a fixed choice more (the Cornell box, direct: estimated 1.86x, about 1.3x

@@ -63,9 +63,9 @@ TEST_CASE("interrupted and killed renders resume to the same bytes", "[checkpoin
 }
 
 TEST_CASE("a render resumed after bayes fell back continues its stratified set", "[checkpoint]") {
-  // The path-traced Cornell box at 40x30 falls back to power sampling at the end of pass 24 (235 spp, its first
-  // check window; see tools/golden.sh): from pass 25 on the model stays, and its samples form one stratified set
-  // starting at 235, which a resume after pass 29 must restore (a set restarted at the resume gives other bytes).
+  // The path-traced Cornell box at 40x30 falls back to power sampling at the end of pass 27 (485 spp; see
+  // golden/manifest.txt): from pass 28 on the model stays, and its samples form one stratified set starting at
+  // 485, which a resume after pass 29 must restore (a set restarted at the resume gives other bytes).
   temp_dir d;
   std::string args = "render " + source_path("data/cornell/path.json") +
                      " --sampler bayes --width 40 --height 30 --spp 677 --quiet";
@@ -81,7 +81,7 @@ TEST_CASE("a render resumed after bayes fell back continues its stratified set",
   auto check = run_bayeslight("render " + source_path("data/cornell/path.json") +
                               " --sampler bayes --width 40 --height 30 --spp 549 -o " + (d / "c.pfm"));
   INFO(check.output);
-  CHECK(check.output.find("power sampling after 235 spp") != std::string::npos);
+  CHECK(check.output.find("power sampling after 485 spp") != std::string::npos);
 }
 
 TEST_CASE("a render of radiance 1e28 resumes to the same bytes", "[checkpoint]") {

@@ -149,9 +149,8 @@ void check_scene(const built_scene& b, int depth, int spp) {
   p.threads = 2;
   std::vector<double> reference;
   double ref_mean = 0;
-  // Every sampler, then bayes again without its fallback to power sampling and with it forced (at 4 spp: the first
-  // checked window, below half the threshold, decides alone), and with clusters refined into members whatever the
-  // depth (members apply in scenes of more than a handful of lights).
+  // Every sampler, then bayes again without its fallback to power sampling and with it forced (at 5 spp), and with
+  // clusters refined into members whatever the depth (members apply in scenes of more than a handful of lights).
   struct run {
     sampler_kind kind;
     double fallback_ratio;
@@ -177,7 +176,7 @@ void check_scene(const built_scene& b, int depth, int spp) {
     if (kind == sampler_kind::bayes) {
       INFO("fell back after " << r.fallback_spp << " spp");
       if (fallback_ratio == 0) CHECK(r.fallback_spp == 0);
-      if (fallback_ratio > 1e6) CHECK(r.fallback_spp == 4);
+      if (fallback_ratio > 1e6) CHECK(r.fallback_spp == 5);
     }
     CHECK(r.stats.bad_samples == 0);
     CHECK(r.spp == spp);

@@ -27,7 +27,7 @@ for scene in cornell living_room plant_room hall; do
   done
 done
 # bayes past its fallback check (in the path-traced Cornell box at this size it falls back to power sampling after
-# 235 spp, its first check window: windows need 262144 samples).
+# 485 spp: its check windows need 262144 samples).
 file="cornell_path_bayes_fallback.pfm"
 args="data/cornell/path.json --sampler bayes --width 40 --height 30 --spp 512 --threads 2 --quiet"
 "$bin" render $args -o "$out/$file"
