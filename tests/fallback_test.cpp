@@ -250,6 +250,35 @@ TEST_CASE("bayes falls back where learning cannot pay and not where it does", "[
   CHECK(off.output.find("power sampling after") == std::string::npos);
 }
 
+TEST_CASE("bayes keeps learning where one check window missed the few points a small lamp lights", "[fallback]") {
+  // A reviewer's scene (stop 33): the Cornell box with a weak 30 cm lamp 1 cm from its x = 0 wall near the floor,
+  // direct, 64 x 48, where a window spans 85 spp. The first window can miss the points by the small lamp and estimate
+  // about 1.2 (seeds 1, 3, 4), below half the threshold of 2.5; the second estimates about 47. Learning pays there
+  // (relMSE at equal time about 0.6x power's), so the decision must wait for the second window: a rule that let one
+  // window below half the threshold decide fell back after 97 spp.
+  temp_dir d;
+  std::string obj = read_text(source_path("data/cornell/cornell.obj"));
+  int vertices = 0;
+  for (size_t at = 0; at < obj.size(); at = obj.find('\n', at) + 1) {
+    if (obj.compare(at, 2, "v ") == 0) vertices++;
+    if (obj.find('\n', at) == std::string::npos) break;
+  }
+  obj += "\nusemtl small\nv 0.01 0.3 2.6\nv 0.01 0.3 2.9\nv 0.01 0.6 2.9\nv 0.01 0.6 2.6\nf";
+  for (int k = 1; k <= 4; k++) obj += " " + std::to_string(vertices + k);
+  write_text(d / "cornell.obj", obj + "\n");
+  write_text(d / "cornell.mtl",
+             read_text(source_path("data/cornell/cornell.mtl")) + "\nnewmtl small\nKd 0 0 0\nKe 2 2 2\n");
+  write_text(d / "direct.json", read_text(source_path("data/cornell/direct.json")));
+  for (const char* seed : {"1", "3"}) {
+    auto r = run_bayeslight("render " + (d / "direct.json") + " --width 64 --height 48 --spp 188 --threads 2 --seed " +
+                            seed + " -o " + (d / "out.pfm"));
+    INFO("seed " << seed << ": " << r.output);
+    REQUIRE(r.status == 0);
+    CHECK(r.output.find("power sampling after") == std::string::npos);
+    CHECK(r.output.find("learning estimated to cut relMSE per sample") != std::string::npos);
+  }
+}
+
 TEST_CASE("a render that falls back is deterministic and resumes to the same bytes", "[fallback]") {
   temp_dir d;
   std::string base = "render " + source_path("data/cornell/path.json") + " --width 320 --height 240 --spp 18 --quiet";
