@@ -5,6 +5,7 @@
 #include "integrator.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -127,6 +128,8 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
                                    in.scene->bounds);
     }
     case sampler_kind::bayes: {
+      if (tree.color.size() != tree.light.size())
+        throw std::logic_error("the bayes sampler needs the light tree's colours (build_light_tree with colors)");
       bayes_sampler s;
       s.tree = &tree;
       s.lights = &lights;

@@ -228,9 +228,29 @@ float box_distance_sq(vec3f alo, vec3f ahi, vec3f blo, vec3f bhi) {
   return d2;
 }
 
+// Emission colour per node: RGB intensity over luminance intensity, white where a node emits nothing. Children
+// before parents: depth-first ids put every child after its parent, so a walk down the ids sums them in order.
+std::vector<vec3f> node_colors(const light_tree_data& t, const light_data& lights, const scene_data& scene) {
+  size_t nodes = t.light.size();
+  std::vector<vec3f> rgb(nodes, vec3f{0, 0, 0});
+  for (size_t v = nodes; v-- > 0;) {
+    if (t.light[v] != invalid_id) {
+      int l = t.light[v];
+      rgb[v] = lights.radiance[size_t(l)] * scene.tri_area[size_t(lights.tri[size_t(l)])];
+    } else {
+      rgb[v] = rgb[size_t(t.left[v])] + rgb[size_t(t.right[v])];
+    }
+  }
+  for (size_t v = 0; v < nodes; v++) {  // in place: each entry is read once, where it is written
+    float y = luminance(rgb[v]);
+    rgb[v] = y > 0 ? rgb[v] / y : vec3f{1, 1, 1};
+  }
+  return rgb;
+}
+
 }  // namespace
 
-light_tree_data build_light_tree(const light_data& lights, const scene_data& scene) {
+light_tree_data build_light_tree(const light_data& lights, const scene_data& scene, bool colors) {
   light_tree_data t;
   t.two_sided = lights.two_sided;
   int n = lights.tri_count;
@@ -259,32 +279,7 @@ light_tree_data build_light_tree(const light_data& lights, const scene_data& sce
   builder bld{t, items};
   t.depth = bld.build(0, n, 0, invalid_id, 0);
   std::vector<build_item>().swap(items);  // (the peak of a large build: not held with the colour pass's arrays)
-  // Emission colour per node: RGB intensity over luminance intensity (children before parents, by an explicit
-  // post-order walk), white where a node emits nothing.
-  std::vector<vec3f> rgb(nodes, vec3f{0, 0, 0});
-  std::vector<int> stack = {0};
-  std::vector<int> order;
-  order.reserve(nodes);
-  while (!stack.empty()) {
-    int v = stack.back();
-    stack.pop_back();
-    order.push_back(v);
-    if (t.light[size_t(v)] == invalid_id) stack.push_back(t.left[size_t(v)]), stack.push_back(t.right[size_t(v)]);
-  }
-  for (size_t k = order.size(); k-- > 0;) {
-    size_t v = size_t(order[k]);
-    if (t.light[v] != invalid_id) {
-      int l = t.light[v];
-      rgb[v] = lights.radiance[size_t(l)] * scene.tri_area[size_t(lights.tri[size_t(l)])];
-    } else {
-      rgb[v] = rgb[size_t(t.left[v])] + rgb[size_t(t.right[v])];
-    }
-  }
-  t.color.resize(nodes);
-  for (size_t v = 0; v < nodes; v++) {
-    float y = luminance(rgb[v]);
-    t.color[v] = y > 0 ? rgb[v] / y : vec3f{1, 1, 1};
-  }
+  if (colors) t.color = node_colors(t, lights, scene);
   // Descent probabilities once per node (the same double expression the descent used to evaluate per visit).
   t.left_prob.assign(nodes, 0.0);
   for (size_t i = 0; i < nodes; i++)

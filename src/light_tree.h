@@ -34,7 +34,8 @@ struct light_tree_data {
   std::vector<int> light;             // leaf: its light id; interior: invalid_id
   std::vector<int> leaf_of_light;     // per triangle light id: its leaf node
   std::vector<double> left_prob;      // interior: probability of the left child when descending by intensity
-  std::vector<vec3f> color;           // emission colour: RGB intensity / luminance intensity (luminance 1)
+  std::vector<vec3f> color;           // emission colour: RGB intensity / luminance intensity (luminance 1); empty
+                                      // when built without colours
   bool two_sided = false;
   int depth = 0;                      // longest root-to-leaf path (edges)
 };
@@ -55,8 +56,9 @@ inline float node_intensity(const light_tree_data& t, int node) { return t.packe
 inline int node_count(const light_tree_data& t) { return int(t.light.size()); }
 inline bool is_leaf(const light_tree_data& t, int node) { return t.light[size_t(node)] != invalid_id; }
 
-// Builds the tree over the triangle lights of `lights` (empty tree when there are none).
-light_tree_data build_light_tree(const light_data& lights, const scene_data& scene);
+// Builds the tree over the triangle lights of `lights` (empty tree when there are none). `colors`: also the emission
+// colour column, which only the bayes sampler reads (12 bytes per node, and the pass that sums it).
+light_tree_data build_light_tree(const light_data& lights, const scene_data& scene, bool colors = true);
 
 // cos(max(0, a - b)) for angles given by (sin, cos), the clamped difference of pbrt-v4's light bounds.
 inline float cos_sub_clamped(float sin_a, float cos_a, float sin_b, float cos_b) {

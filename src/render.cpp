@@ -352,7 +352,8 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   std::optional<slow_phase_note> note(std::in_place, params.notes,
                                       "setting up the light sampler (light tree, regions of the first hits) ...");
   light_tree_data tree;
-  if (needs_light_tree(params.sampler.kind)) tree = build_light_tree(lights, scene);
+  if (needs_light_tree(params.sampler.kind))
+    tree = build_light_tree(lights, scene, params.sampler.kind == sampler_kind::bayes);  // (colours: bayes only)
   light_sampler sampler = make_light_sampler(params.sampler, in, tree);
   render_result restored;
   restored.width = params.width;

@@ -340,6 +340,37 @@ TEST_CASE("a light tree built by parallel tasks does not depend on the thread co
   CHECK(t.depth == one.depth);
 }
 
+TEST_CASE("a node's colour is its lights' RGB intensity over their luminance intensity", "[light_tree]") {
+  // Lights of random colours: each node's colour times its intensity is the sum of its lights' radiance times area
+  // (luminance 1 for a node that emits). Built without colours (every sampler but bayes), the column is empty and
+  // every other column the same.
+  light_set s = make_light_set(5, 3000, layout::scattered, false);
+  light_tree_data t = build_light_tree(s.lights, s.scene);
+  REQUIRE(t.color.size() == t.light.size());
+  for (int i = 0; i < node_count(t); i++) {
+    std::vector<int> leaves;
+    leaves_under(t, i, leaves);
+    double rgb[3] = {0, 0, 0};
+    for (int leaf : leaves) {
+      int l = t.light[size_t(leaf)];
+      vec3f e = s.lights.radiance[size_t(l)] * s.scene.tri_area[size_t(s.lights.tri[size_t(l)])];
+      for (int c = 0; c < 3; c++) rgb[c] += double(e[c]);
+    }
+    vec3f col = t.color[size_t(i)];
+    INFO("node " << i << " of " << leaves.size() << " lights");
+    CHECK(double(luminance(col)) == Approx(1).epsilon(1e-4));
+    for (int c = 0; c < 3; c++)
+      CHECK(double(col[c]) * double(node_intensity(t, i)) == Approx(rgb[c]).epsilon(1e-3).margin(1e-30));
+  }
+  light_tree_data bare = build_light_tree(s.lights, s.scene, false);
+  CHECK(bare.color.empty());
+  CHECK(same_column(bare.lo, t.lo));
+  CHECK(same_column(bare.left_prob, t.left_prob));
+  CHECK(same_column(bare.light, t.light));
+  REQUIRE(bare.packed.size() == t.packed.size());
+  CHECK(std::memcmp(bare.packed.data(), t.packed.data(), t.packed.size() * sizeof(node_pack)) == 0);
+}
+
 TEST_CASE("a scene without emitters has an empty light tree", "[light_tree]") {
   mesh_builder b;
   int wall = b.add_material({0.5f, 0.5f, 0.5f});
