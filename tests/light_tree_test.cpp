@@ -140,6 +140,24 @@ bool same_column(const std::vector<T>& a, const std::vector<T>& b) {
 }
 bool same_column(const std::vector<int>& a, const std::vector<int>& b) { return a == b; }
 
+// Every column of two trees bit for bit (the colour column too unless `colors` is false).
+void check_same_tree(const light_tree_data& a, const light_tree_data& b, bool colors = true) {
+  REQUIRE(node_count(a) == node_count(b));
+  CHECK(same_column(a.lo, b.lo));
+  CHECK(same_column(a.hi, b.hi));
+  CHECK(same_column(a.left, b.left));
+  CHECK(same_column(a.right, b.right));
+  CHECK(same_column(a.parent, b.parent));
+  CHECK(same_column(a.light, b.light));
+  CHECK(same_column(a.leaf_of_light, b.leaf_of_light));
+  CHECK(same_column(a.left_prob, b.left_prob));
+  if (colors) CHECK(same_column(a.color, b.color));
+  REQUIRE(a.packed.size() == b.packed.size());
+  CHECK(std::memcmp(a.packed.data(), b.packed.data(), a.packed.size() * sizeof(node_pack)) == 0);
+  CHECK(a.depth == b.depth);
+  CHECK(a.two_sided == b.two_sided);
+}
+
 // Angle in double between two (not necessarily unit) vectors.
 double angle_between(vec3f a, vec3f b) {
   double ax = a.x, ay = a.y, az = a.z, bx = b.x, by = b.y, bz = b.z;
@@ -301,17 +319,7 @@ TEST_CASE("light tree structure holds its invariants on random light sets", "[li
     CHECK(deepest == t.depth);
     CHECK(t.depth <= max_tree_depth);
     // Deterministic: a second build is bit-identical.
-    light_tree_data t2 = build_light_tree(s.lights, s.scene);
-    CHECK(same_column(t.lo, t2.lo));
-    CHECK(same_column(t.hi, t2.hi));
-    CHECK(same_column(t.left, t2.left));
-    CHECK(same_column(t.right, t2.right));
-    CHECK(same_column(t.parent, t2.parent));
-    CHECK(same_column(t.light, t2.light));
-    CHECK(same_column(t.leaf_of_light, t2.leaf_of_light));
-    REQUIRE(t.packed.size() == t2.packed.size());
-    CHECK(std::memcmp(t.packed.data(), t2.packed.data(), t.packed.size() * sizeof(node_pack)) == 0);
-    CHECK(t.depth == t2.depth);
+    check_same_tree(t, build_light_tree(s.lights, s.scene));
   }
 }
 
@@ -324,20 +332,7 @@ TEST_CASE("a light tree built by parallel tasks does not depend on the thread co
     one = build_light_tree(s.lights, s.scene);
   }
   tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
-  light_tree_data t = build_light_tree(s.lights, s.scene);
-  REQUIRE(node_count(one) == node_count(t));
-  CHECK(same_column(t.lo, one.lo));
-  CHECK(same_column(t.hi, one.hi));
-  CHECK(same_column(t.left, one.left));
-  CHECK(same_column(t.right, one.right));
-  CHECK(same_column(t.light, one.light));
-  CHECK(same_column(t.left_prob, one.left_prob));
-  CHECK(same_column(t.parent, one.parent));
-  CHECK(same_column(t.color, one.color));
-  CHECK(same_column(t.leaf_of_light, one.leaf_of_light));
-  REQUIRE(t.packed.size() == one.packed.size());
-  CHECK(std::memcmp(t.packed.data(), one.packed.data(), t.packed.size() * sizeof(node_pack)) == 0);
-  CHECK(t.depth == one.depth);
+  check_same_tree(build_light_tree(s.lights, s.scene), one);
 }
 
 TEST_CASE("a node's colour is its lights' RGB intensity over their luminance intensity", "[light_tree]") {
@@ -364,11 +359,7 @@ TEST_CASE("a node's colour is its lights' RGB intensity over their luminance int
   }
   light_tree_data bare = build_light_tree(s.lights, s.scene, false);
   CHECK(bare.color.empty());
-  CHECK(same_column(bare.lo, t.lo));
-  CHECK(same_column(bare.left_prob, t.left_prob));
-  CHECK(same_column(bare.light, t.light));
-  REQUIRE(bare.packed.size() == t.packed.size());
-  CHECK(std::memcmp(bare.packed.data(), t.packed.data(), t.packed.size() * sizeof(node_pack)) == 0);
+  check_same_tree(bare, t, false);
 }
 
 TEST_CASE("a scene without emitters has an empty light tree", "[light_tree]") {
