@@ -161,7 +161,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
         if (prev_mis) {
           float cos_l = std::fabs(dot(scene.tri_ng[h.tri], dir));
           float light_pdf = sampler.pmf(ctxs[(depth - 1) & 1], hit_light) *
-                            triangle_light_pdf(scene, lights, hit_light, h.t, cos_l);
+                            triangle_light_pdf(scene, lights, hit_light, org, h.t, cos_l);
           w = power_heuristic(prev_bsdf_pdf, light_pdf);
         }
         radiance += beta * le * w;

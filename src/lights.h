@@ -48,14 +48,35 @@ struct light_sample {
   int tri = invalid_id;     // the emitter's triangle (invalid for the sun)
 };
 
-// Samples a point of light `light` seen from x with uniforms (u, v).
+// Samples a point of light `light` seen from x with uniforms (u, v). A triangle that x sees under a solid angle of
+// at least spherical_min_solid_angle is sampled uniformly in that solid angle (Arvo 1995: pdf 1 / omega, so the
+// estimate carries neither the 1/d^2 nor the emitter's cosine, which uniform points spread over orders of magnitude
+// for a point close to a large emitter); any other triangle uniformly by area (pdf d^2 / (cos_l area)).
 light_sample sample_light_point(const light_data& lights, const scene_data& scene, int light, vec3f x, float u,
                                 float v);
-// Solid-angle pdf of sampling a triangle light's point at distance dist whose emitter cosine is cos_l.
-inline float triangle_light_pdf(const scene_data& scene, const light_data& lights, int light, float dist,
+
+// Where solid-angle sampling starts: below about 0.3 sr the 1/d^2 and cosine of a uniform point on the triangle vary
+// by less than a factor of two (little variance to remove) and sampling by area is cheaper. Above 2 pi - 0.02
+// (a point a hair above a triangle's inside) the spherical triangle is nearly a hemisphere and its float angles
+// lose their precision: area sampling again.
+inline constexpr float spherical_min_solid_angle = 0.3f;
+inline constexpr float spherical_max_solid_angle = 2 * pi_f - 0.02f;
+
+// The solid angle under which x sees scene triangle t when it is to be sampled by solid angle from x (between
+// spherical_min_solid_angle and spherical_max_solid_angle), else 0. A function of x and t alone, so that sampling
+// and the pdf a BSDF hit evaluates for MIS always agree.
+float spherical_solid_angle(const scene_data& scene, int t, vec3f x);
+
+// Solid-angle pdf of sampling, from x, the point of triangle light `light` at distance dist whose emitter cosine is
+// cos_l (the emitting side's; 0 or less: none).
+inline float triangle_light_pdf(const scene_data& scene, const light_data& lights, int light, vec3f x, float dist,
                                 float cos_l) {
-  float a = scene.tri_area[lights.tri[light]];
-  return cos_l > 0 && a > 0 ? dist * dist / (cos_l * a) : 0;
+  if (!(cos_l > 0)) return 0;
+  int t = lights.tri[light];
+  float omega = spherical_solid_angle(scene, t, x);
+  if (omega > 0) return 1 / omega;
+  float a = scene.tri_area[t];
+  return a > 0 ? dist * dist / (cos_l * a) : 0;
 }
 // Radiance an emissive triangle sends toward a ray that hit its front (front=true) or back side.
 inline bool emits_both_sides(const light_data& lights, int light) {

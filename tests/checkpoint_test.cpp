@@ -132,18 +132,22 @@ TEST_CASE("a render of a lamp of radiance FLT_MAX in view resumes", "[checkpoint
 }
 
 TEST_CASE("renders whose NEE estimates overflow float resume, learners included", "[checkpoint]") {
-  // A 2-micrometre lamp of radiance 3e38 a tenth of a micrometre above a floor: some NEE estimates overflow (dropped
-  // from the image). bayes recorded them (a pair's mean inf, its squared deviations NaN), donikian summed their
-  // overflowing ratios into its estimates: either render's own checkpoint was then refused as corrupt.
+  // A 2-micrometre lamp of radiance 3e38 a tenth of a micrometre above a glossy floor (Phong exponent 1000), seen
+  // past its edge where the floor mirrors it: NEE estimates in its highlight overflow (dropped from the image). bayes
+  // recorded them (a pair's mean inf, its squared deviations NaN), donikian summed their overflowing ratios into its
+  // estimates: either render's own checkpoint was then refused as corrupt.
   temp_dir d;
   write_text(d / "t.obj", "mtllib t.mtl\nv 0 0 0\nv 1e-5 0 0\nv 1e-5 1e-5 0\nv 0 1e-5 0\nv 4e-6 4e-6 1e-7\n"
                           "v 4e-6 6e-6 1e-7\nv 6e-6 6e-6 1e-7\nv 6e-6 4e-6 1e-7\nusemtl floor\nf 1 2 3\nf 1 3 4\n"
                           "usemtl lamp\nf 5 6 7\nf 5 7 8\n");
-  write_text(d / "t.mtl", "newmtl floor\nKd 0.8 0.8 0.8\nnewmtl lamp\nKd 0 0 0\nKe 3e38 3e38 3e38\n");
+  write_text(d / "t.mtl", "newmtl floor\nKd 0.3 0.3 0.3\nKs 0.5 0.5 0.5\nNs 1000\n"
+                          "newmtl lamp\nKd 0 0 0\nKe 3e38 3e38 3e38\n");
+  write_text(d / "t.json", "{\"mesh\": \"t.obj\", \"camera\": {\"eye\": [1e-6, 5e-6, 4e-7], \"target\": [4.2e-6, 5e-6, 0], "
+                           "\"up\": [0, 0, 1], \"fov_y_deg\": 10}}\n");
   for (const char* sampler : {"bayes", "donikian"})
     for (const char* depth : {"1", "3"}) {
       INFO(sampler << " max depth " << depth);
-      std::string args = "render " + (d / "t.obj") + " --sampler " + sampler + " --max-depth " + depth +
+      std::string args = "render " + (d / "t.json") + " --sampler " + sampler + " --max-depth " + depth +
                          " --width 64 --height 64 --checkpoint " + (d / "ck.bin") + " -o " + (d / "a.pfm");
       auto first = run_bayeslight(args + " --spp 16");
       INFO(first.output);

@@ -265,17 +265,19 @@ TEST_CASE("a sliver emitter of area 1e-10 renders consistently with every sample
 
 
 TEST_CASE("NEE samples that overflow to infinity leave the Bayesian statistics finite", "[stiff]") {
-  // A 2-micrometre lamp of radiance 3e38 (power 4e27, which the loader accepts) 0.1 micrometre above a floor: some
-  // NEE estimates overflow float. The integrator drops them from the image (bad samples); before stop 29 they were
-  // also recorded, so a pair's mean became inf and its m2 NaN for good (Chan's update keeps a NaN), its weight the
-  // 1e35 clamp, and the render's checkpoint failed its own finiteness check on --resume.
+  // A 2-micrometre lamp of radiance 3e38 (power 4e27, which the loader accepts) 0.1 micrometre above a glossy floor
+  // (Phong exponent 1000): NEE estimates in the lamp's highlight overflow float, whichever way its points are
+  // sampled (by solid angle, the lamp's 1/d^2 no longer does). The integrator drops them from the image (bad
+  // samples); before stop 29 they were also recorded, so a pair's mean became inf and its m2 NaN for good (Chan's
+  // update keeps a NaN), its weight the 1e35 clamp, and the render's checkpoint failed its own finiteness check on
+  // --resume.
   mesh_builder m;
-  int floor = m.add_material({0.8f, 0.8f, 0.8f});
+  int floor = m.add_material({0.3f, 0.3f, 0.3f}, {0, 0, 0}, {0.5f, 0.5f, 0.5f}, 1000);
   int lamp = m.add_material({0, 0, 0}, {3e38f, 3e38f, 3e38f});
   m.add_quad({0, 0, 0}, {0, 0, 1e-5f}, {1e-5f, 0, 1e-5f}, {1e-5f, 0, 0}, floor);
   m.add_quad({4e-6f, 1e-7f, 4e-6f}, {6e-6f, 1e-7f, 4e-6f}, {6e-6f, 1e-7f, 6e-6f}, {4e-6f, 1e-7f, 6e-6f}, lamp);
-  // Looking down at the lamp's rim: half the view is floor within 0.2 micrometres of it.
-  auto b = build(std::move(m.mesh), looking_down({6e-6f, 2e-6f, 5.01e-6f}, {6e-6f, 0, 5e-6f}, 10));
+  // Looking past the lamp's edge, 7 degrees down, at the floor just under it, whose mirror direction meets the lamp.
+  auto b = build(std::move(m.mesh), looking_down({1e-6f, 4e-7f, 5e-6f}, {4.2e-6f, 0, 5e-6f}, 10));
   check_bayes_state(*b, 1, {}, true);
   check_bayes_state(*b, 3, {}, true);
 }
