@@ -51,99 +51,150 @@ void set_sun_direction(light_data& l, vec3f direction) {
 
 namespace {
 
-// Triangle t as seen from x, in units of |p0 - x| (so that neither the products of three lengths below nor the warp
-// leave float's range at any scene scale): corner 0's offset a = (p0 - x) / |p0 - x|, the edges in those units.
+// Solid-angle sampling computes in double: where the shading point lies near the line through two corners (a lamp
+// standing on the floor it lights, the diagonal of a quad lamp just above a point), those corners' directions are
+// nearly opposite, and float's cross products and Arvo's formula lost so much there that the warp put samples 1 rad
+// off their place (a review: irradiance 0.02 mm from a 1 m panel at half its value). Double's +, -, *, / and sqrt are
+// correctly rounded, so the result is the same on every machine; the two transcendental calls stay in float
+// (glibc's double sin/atan2 differ in the last bit between CPUs with and without FMA; STACK.md).
+struct dvec3 {
+  double x = 0, y = 0, z = 0;
+};
+dvec3 to_double(vec3f v) { return {v.x, v.y, v.z}; }
+dvec3 operator+(dvec3 a, dvec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+dvec3 operator-(dvec3 a, dvec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+dvec3 operator*(dvec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+double dot(dvec3 a, dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+dvec3 cross(dvec3 a, dvec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double length(dvec3 a) { return std::sqrt(dot(a, a)); }
+// a / |a|, or zero for a zero vector.
+dvec3 unit(dvec3 a) {
+  double l = length(a);
+  return l > 0 ? a * (1 / l) : dvec3{};
+}
+
+// Triangle t as seen from x, in units of |p0 - x| (so that no product of lengths leaves double's range at any
+// scene scale): its corners' offsets from x (p0 - x and the edges e1, e2 as stored), and the same triangle with its
+// corners renamed cyclically for the warp (a: corner A's offset, e1 = B - A, e2 = C - A) so that the two whose
+// directions from x are the most nearly opposite are A and C, the pair Arvo's construction handles best (B and C'
+// then never meet head-on, and A B is never the long arc its formula divides by): with A and B opposite, in double,
+// 1e-4 below a quad's diagonal, the estimate was still 0.6 % high.
+constexpr double spherical_max_second_opposite = 0.999;
 struct triangle_view {
-  vec3f a, e1, e2;
-  float la = 0;      // |a| (1 up to rounding)
-  float triple = 0;  // a . (e1 x e2): its sign tells the side x is on (negative: the front)
-  float omega = 0;   // solid angle; 0 = sample by area
+  dvec3 p0, e1, e2;  // as stored: corner 0's offset, edges
+  dvec3 a, ab, ac;   // renamed for the warp: A's offset, B - A, C - A
+  double triple = 0;  // a . (e1 x e2) (any naming): its sign tells the side x is on (negative: the front)
+  float omega = 0;    // solid angle; 0 = sample by area
 };
 
-// The solid angle from the corners' offsets a, b = a + e1, c = a + e2, in forms that keep float precision for a
-// small or distant triangle: tan(omega / 2) = |a . (b x c)| / (|a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|)
-// (Van Oosterom and Strackee 1983), with the triple product taken from the edges (a . (e1 x e2): no cancellation
-// between nearly parallel corners).
+// The solid angle from the corners' offsets a, b = a + e1, c = a + e2: tan(omega / 2) = |a . (b x c)| /
+// (|a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|) (Van Oosterom and Strackee 1983), the triple product taken from the
+// edges (a . (e1 x e2): no cancellation between nearly parallel corners).
 triangle_view view_of(const scene_data& scene, int t, vec3f x) {
   triangle_view w;
   vec3f e1 = scene.tri_e1[size_t(t)], e2 = scene.tri_e2[size_t(t)], p0 = scene.tri_p0[size_t(t)];
-  // Cheap rejection: the triangle lies in the ball about its centroid through its farthest corner, and from outside a
-  // ball of radius r at distance d the ball subtends 2 pi (1 - cos) with sin^2 = r^2 / d^2; below the threshold's
-  // sin^2 the triangle cannot reach it.
+  // Cheap rejections, in float with a margin for rounding (a triangle they turn away is sampled by area, which is
+  // always valid). The triangle lies in the ball about its centroid through its farthest corner (radius r, centre at
+  // distance d), which from outside subtends 2 pi (1 - cos) with sin^2 = r^2 / d^2: below the threshold's sin^2 the
+  // triangle cannot reach it. Closer, every point of the triangle is at least m = max(d - r, |h|) from x (h: x's
+  // distance to the plane), and omega = integral of |h| / dist^3 over the area is at most area |h| / m^3.
   constexpr float s_min = spherical_min_solid_angle * inv_pi_f -
                           spherical_min_solid_angle * spherical_min_solid_angle * (0.25f * inv_pi_f * inv_pi_f);
+  constexpr float margin = 0.999f;
   vec3f g = (e1 + e2) * (1.0f / 3.0f);
   float r2 = std::max(length_sq(g), std::max(length_sq(g - e1), length_sq(g - e2)));
   float d2 = length_sq(p0 + g - x);
-  if (r2 < s_min * d2) return w;
-  vec3f a = p0 - x;
-  float k = 1 / length(a);
+  if (r2 < margin * s_min * d2) return w;
+  float h = std::fabs(dot(scene.tri_ng[size_t(t)], x - p0));
+  float m = std::max(std::sqrt(d2) - std::sqrt(r2), h);
+  if (scene.tri_area[size_t(t)] * h < margin * spherical_min_solid_angle * (m * m * m)) return w;
+  dvec3 a = to_double(p0) - to_double(x);
+  double k = 1 / length(a);
   if (!std::isfinite(k)) return w;
-  w.a = a * k, w.e1 = e1 * k, w.e2 = e2 * k;
-  vec3f b = w.a + w.e1, c = w.a + w.e2;
-  w.la = length(w.a);
-  float lb = length(b), lc = length(c);
-  w.triple = dot(w.a, cross(w.e1, w.e2));
-  float den = w.la * lb * lc + dot(w.a, b) * lc + dot(b, c) * w.la + dot(c, w.a) * lb;
-  if (!(lb > 0 && lc > 0) || !std::isfinite(den) || !std::isfinite(w.triple)) return w;
-  float omega = 2 * std::atan2(std::fabs(w.triple), den);
-  if (omega >= spherical_min_solid_angle && omega <= spherical_max_solid_angle) w.omega = omega;
+  w.p0 = a * k, w.e1 = to_double(e1) * k, w.e2 = to_double(e2) * k;
+  dvec3 c[3] = {w.p0, w.p0 + w.e1, w.p0 + w.e2};
+  double l[3] = {length(c[0]), length(c[1]), length(c[2])};
+  w.triple = dot(w.p0, cross(w.e1, w.e2));
+  double den = l[0] * l[1] * l[2] + dot(c[0], c[1]) * l[2] + dot(c[1], c[2]) * l[0] + dot(c[2], c[0]) * l[1];
+  if (!(l[1] > 0 && l[2] > 0) || !std::isfinite(den) || !std::isfinite(w.triple)) return w;
+  // omega = 2 atan2(|triple|, den), compared with the thresholds through their half-angle tangents first (the
+  // arctangent only where solid-angle sampling is taken): omega >= min where den <= 0 (omega >= pi) or
+  // |triple| >= den tan(min / 2); omega <= max where den >= 0 or |triple| >= -den tan(pi - max / 2).
+  double y = std::fabs(w.triple);
+  bool above_min = den <= 0 || y >= den * double(spherical_min_tan_half);
+  bool below_max = den >= 0 || y >= -den * double(spherical_max_cot_half);
+  if (!(above_min && below_max)) return w;
+  // B: the corner outside the most nearly opposite pair (the lowest cosine between two corners' directions). Where a
+  // second pair is nearly opposite too (x within a sliver's width of two of its edge lines: B then lies next to A,
+  // and the arc from B to C' turns on rounding as C' nears C), area sampling.
+  double cos01 = dot(c[0], c[1]) / (l[0] * l[1]), cos12 = dot(c[1], c[2]) / (l[1] * l[2]),
+         cos20 = dot(c[2], c[0]) / (l[2] * l[0]);
+  int b = cos01 <= cos12 && cos01 <= cos20 ? 2 : cos12 <= cos20 ? 0 : 1;
+  double second = b == 2 ? std::min(cos12, cos20) : b == 0 ? std::min(cos01, cos20) : std::min(cos01, cos12);
+  if (second < -spherical_max_second_opposite) return w;
+  // The arctangent of the ratio's float rounding: a relative error of 1e-7 at most, from any ratio.
+  double scale = std::max(y, std::fabs(den));
+  w.omega = 2 * std::atan2(float(y / scale), float(den / scale));
+  w.a = c[(b + 2) % 3];
+  w.ab = c[b] - w.a;
+  w.ac = c[(b + 1) % 3] - w.a;
   return w;
 }
 
 // Arvo's warp (Arvo 1995, "Stratified sampling of spherical triangles"): u picks the sub-triangle A B C' of area
 // u omega with C' on the arc from A to C, v the point on the arc from B to C' (uniform in solid angle over the
-// whole). The angle at A and the great circles' directions come from cross products with the edges (a x e1 is
-// a x b, a x e2 is a x c), which keep their precision where the corners' directions nearly coincide. Returns the
-// unit direction, or zero where rounding leaves no valid one.
-vec3f spherical_direction(const triangle_view& w, float u, float v) {
-  vec3f b = w.a + w.e1;
-  vec3f A = w.a / w.la, B = b / length(b);
-  vec3f n_ab = cross(w.a, w.e1), n_ac = cross(w.a, w.e2);
-  // The angle at A: between the planes through A and B and through A and C; |n_ab x n_ac| = |a| |a . (e1 x e2)|.
-  float sin_part = w.la * std::fabs(w.triple), cos_part = dot(n_ab, n_ac);
-  float h = std::sqrt(sin_part * sin_part + cos_part * cos_part);
-  if (!(h > 0)) return {0, 0, 0};
-  float sin_alpha = sin_part / h, cos_alpha = cos_part / h;
-  float cos_c = dot(A, B);
+// whole). The angle at A and the great circles' directions come from cross products with the edges (a x ab is
+// a x b, a x ac is a x c). Returns the unit direction, or zero where no valid one is left.
+dvec3 spherical_direction(const triangle_view& w, float u, float v) {
+  dvec3 b = w.a + w.ab;
+  dvec3 A = unit(w.a), B = unit(b);
+  dvec3 n_ab = cross(w.a, w.ab), n_ac = cross(w.a, w.ac);
+  // The angle at A: between the planes through A and B and through A and C; |n_ab x n_ac| = |a| |a . (ab x ac)|.
+  double sin_part = length(w.a) * std::fabs(w.triple), cos_part = dot(n_ab, n_ac);
+  double h = std::sqrt(sin_part * sin_part + cos_part * cos_part);
+  if (!(h > 0)) return {};
+  double sin_alpha = sin_part / h, cos_alpha = cos_part / h;
+  double cos_c = dot(A, B);
   float area = u * w.omega;
-  float sin_area = std::sin(area), cos_area = std::cos(area);
+  double sin_area = std::sin(area), cos_area = std::cos(area);
   // s, t: sine and cosine of (area - alpha).
-  float s = sin_area * cos_alpha - cos_area * sin_alpha, t = cos_area * cos_alpha + sin_area * sin_alpha;
-  float p = t - cos_alpha, q = s + sin_alpha * cos_c;
-  float cos_b = ((q * t - p * s) * cos_alpha - q) / ((q * s + p * t) * sin_alpha);  // cosine of the arc A C'
-  if (!std::isfinite(cos_b)) return {0, 0, 0};
-  cos_b = clampf(cos_b, -1.0f, 1.0f);
-  vec3f toward_c = normalize(cross(n_ac, w.a));  // unit, perpendicular to A, in the plane of A and C, toward C
-  vec3f c_prime = A * cos_b + toward_c * safe_sqrt(1 - cos_b * cos_b);
-  float z = 1 - v * (1 - dot(c_prime, B));
-  vec3f perp = normalize(c_prime - B * dot(c_prime, B));
-  return B * z + perp * safe_sqrt(1 - z * z);
+  double s = sin_area * cos_alpha - cos_area * sin_alpha, t = cos_area * cos_alpha + sin_area * sin_alpha;
+  double p = t - cos_alpha, q = s + sin_alpha * cos_c;
+  double cos_b = ((q * t - p * s) * cos_alpha - q) / ((q * s + p * t) * sin_alpha);  // cosine of the arc A C'
+  if (!std::isfinite(cos_b)) return {};
+  cos_b = std::min(std::max(cos_b, -1.0), 1.0);
+  dvec3 toward_c = unit(cross(n_ac, w.a));  // perpendicular to A, in the plane of A and C, toward C
+  dvec3 c_prime = A * cos_b + toward_c * std::sqrt(1 - cos_b * cos_b);
+  double z = 1 - v * (1 - dot(c_prime, B));
+  dvec3 perp = unit(c_prime - B * dot(c_prime, B));
+  return B * z + perp * std::sqrt(std::max(1 - z * z, 0.0));
 }
 
 // The light sample of a triangle sampled by solid angle (w.omega > 0): the direction from Arvo's warp, the point
-// where it meets the triangle's plane (as barycentrics clamped onto the triangle, so the point lies on it as an area
-// sample's does), pdf 1 / omega.
+// where it meets the triangle's plane (as barycentrics clamped onto the triangle against rounding, so the point lies
+// on it as an area sample's does), pdf 1 / omega.
 light_sample sample_by_solid_angle(const light_data& l, const scene_data& scene, int light, vec3f x,
                                    const triangle_view& w, float u, float v, light_sample s) {
   int t = s.tri;
   bool front = w.triple < 0;
   if (w.triple == 0 || (!front && !emits_both_sides(l, light))) return s;
-  vec3f e1 = w.e1, e2 = w.e2, n = cross(e1, e2);  // in the view's units
-  vec3f dir = spherical_direction(w, u, v);
-  float along = dot(n, w.a) / dot(n, dir);
+  dvec3 n = cross(w.e1, w.e2);  // in the view's units
+  dvec3 dir = spherical_direction(w, u, v);
+  double along = dot(n, w.p0) / dot(n, dir);
   if (!(along > 0) || !std::isfinite(along)) return s;
-  vec3f rel = dir * along - w.a;  // the plane point relative to corner 0
-  float d00 = dot(e1, e1), d01 = dot(e1, e2), d11 = dot(e2, e2), d20 = dot(rel, e1), d21 = dot(rel, e2);
-  float den = length_sq(n);
-  float b1 = std::max((d11 * d20 - d01 * d21) / den, 0.0f), b2 = std::max((d00 * d21 - d01 * d20) / den, 0.0f);
+  dvec3 rel = dir * along - w.p0;  // the plane point relative to corner 0
+  double d00 = dot(w.e1, w.e1), d01 = dot(w.e1, w.e2), d11 = dot(w.e2, w.e2), d20 = dot(rel, w.e1),
+         d21 = dot(rel, w.e2);
+  double den = dot(n, n);
+  double b1 = std::max((d11 * d20 - d01 * d21) / den, 0.0), b2 = std::max((d00 * d21 - d01 * d20) / den, 0.0);
   if (!(b1 + b2 <= 1)) {
-    float sum = b1 + b2;
+    double sum = b1 + b2;
     if (!std::isfinite(sum)) return s;
     b1 /= sum, b2 /= sum;
   }
-  if (scene.has_alpha && alpha_hole(scene, t, b1, b2)) return s;
-  s.p = scene.tri_p0[size_t(t)] + scene.tri_e1[size_t(t)] * b1 + scene.tri_e2[size_t(t)] * b2;
+  float fb1 = float(b1), fb2 = float(b2);
+  if (scene.has_alpha && alpha_hole(scene, t, fb1, fb2)) return s;
+  s.p = scene.tri_p0[size_t(t)] + scene.tri_e1[size_t(t)] * fb1 + scene.tri_e2[size_t(t)] * fb2;
   vec3f d = s.p - x;
   float dist2 = length_sq(d);
   if (!(dist2 > 0)) return s;

@@ -128,11 +128,23 @@ double warp_pvalue(const one_triangle& t, vec3f x, int n, int samples, uint64_t 
   return chi2_pvalue(obs, exp);
 }
 
+// Mean and standard error of the irradiance estimate le cos / pdf at x (receiver normal n) from `samples` light
+// samples of one triangle.
+mean_se irradiance_estimate(const one_triangle& t, vec3f x, vec3f n, int samples, uint64_t seed) {
+  std::vector<double> e;
+  for (int s = 0; s < samples; s++) {
+    vec2f u = uniform_pair(seed, uint64_t(s));
+    light_sample ls = sample_light_point(t.lights, t.scene, 0, x, u.x, u.y);
+    e.push_back(ls.pdf > 0 ? double(ls.le.x) * std::max(0.0f, dot(n, ls.wi)) / ls.pdf : 0.0);
+  }
+  return mean_and_se(e);
+}
+
 }  // namespace
 
 TEST_CASE("solid-angle samples of a triangle light are uniform in its solid angle", "[lights]") {
   // A triangle of about 1 m seen from points below it at heights from 1 m to 2 mm (solid angle 0.4 to 6.2 sr), from
-  // beside it at grazing angles, and a sliver 100:1 close by.
+  // beside it at grazing angles, and a sliver 1000:1 close by.
   const vec3f p0 = {-0.6f, 1, -0.4f}, p1 = {0.7f, 1, -0.3f}, p2 = {0.1f, 1, 0.8f};
   one_triangle tri(p0, p1, p2);  // faces down (e1 x e2 along -y)
   int configs = 0;
@@ -159,11 +171,25 @@ TEST_CASE("solid-angle samples of a triangle light are uniform in its solid angl
     INFO("scale " << scale);
     CHECK(warp_pvalue(scaled, x, 6, 60000, 9) > 1e-4);
   }
-  one_triangle sliver({0, 1, 0}, {0.01f, 1, 1}, {1, 1, 0}, true);
-  {
-    vec3f x = {0.2f, 0.9f, 0.2f};
-    INFO("sliver");
-    CHECK(warp_pvalue(sliver, x, 4, 60000, 8) > 1e-4);
+  // A sliver 50:1 (1 m by 2 cm) 5 cm above, with its sharp corner first, second and third: the tip and the far
+  // corners lie in nearly opposite directions (cosines -0.98).
+  for (int k = 0; k < 3; k++) {
+    const vec3f tip = {0, 1, 0}, s1 = {1, 1, 0.01f}, s2 = {1, 1, -0.01f};
+    one_triangle sliver(k == 0 ? tip : k == 1 ? s2 : s1, k == 0 ? s1 : k == 1 ? tip : s2,
+                        k == 0 ? s2 : k == 1 ? s1 : tip, true);
+    INFO("sliver, its tip corner " << k);
+    CHECK(warp_pvalue(sliver, {0.5f, 0.95f, 0}, 4, 60000, uint64_t(8 + k)) > 1e-4);
+  }
+  // 1000:1 (2 mm wide) from 1 mm under it: the tip lies within 0.3 degree of opposite both far corners, where the
+  // warp's arc from B to C' turns on rounding (samples 0.4 rad off its place): area sampling there.
+  for (int k = 0; k < 3; k++) {
+    const vec3f tip = {0, 1, 0}, s1 = {1, 1, 0.001f}, s2 = {1, 1, -0.001f};
+    one_triangle thin(k == 0 ? tip : k == 1 ? s2 : s1, k == 0 ? s1 : k == 1 ? tip : s2, k == 0 ? s2 : k == 1 ? s1 : tip,
+                      true);
+    const vec3f x = {0.5f, 0.999f, 0};
+    INFO("thin sliver, its tip corner " << k);
+    CHECK(solid_angle(to_d(x), thin.corner(0), thin.corner(1), thin.corner(2)) > 1);
+    CHECK(spherical_solid_angle(thin.scene, 0, x) == 0);
   }
 }
 
@@ -218,6 +244,9 @@ TEST_CASE("solid-angle sampling takes the triangles a point sees large, and only
   }
   CHECK(solid > 1000);
   CHECK(area > 1000);
+  // The tangents the rule compares belong to the thresholds.
+  CHECK(std::tan(0.5 * double(spherical_min_solid_angle)) == Approx(spherical_min_tan_half).epsilon(1e-6));
+  CHECK(std::tan(M_PI - 0.5 * double(spherical_max_solid_angle)) == Approx(spherical_max_cot_half).epsilon(1e-4));
 }
 
 TEST_CASE("a one-sided triangle sampled by solid angle gives nothing behind it", "[lights]") {
@@ -272,4 +301,38 @@ TEST_CASE("irradiance near a large triangle: solid-angle samples match Lambert's
     CHECK(std::fabs(ma.mean - exact) < 4.4 * ma.se);
     CHECK(m.se < 0.1 * ma.se);
   }
+}
+
+TEST_CASE("points on the line through two corners of a lamp get its irradiance, every corner order", "[lights]") {
+  // Seen from a point near the line through two corners, between them, those corners lie in nearly opposite
+  // directions: in float, Arvo's construction lost its precision there (a review: 0.02 mm from the foot of a 1 m
+  // panel standing on a floor, half the irradiance; 0.1 mm under a quad lamp's diagonal, 22 % low or 52 % high by
+  // corner order). Each case: every cyclic order of the corners, against Lambert's formula (4.4 standard errors).
+  struct lamp_case {
+    const char* name;
+    vec3f c0, c1, c2, x, n;
+  };
+  const lamp_case cases[] = {
+      // Half of a 1 m quad lamp facing down, 0.1 mm and 1 mm under its diagonal (x near the line c0 c1).
+      {"0.1 mm under a quad's diagonal", {0, 1, 0}, {1, 1, 1}, {1, 1, 0}, {0.5f, 0.9999f, 0.5f}, {0, 1, 0}},
+      {"1 mm under a quad's diagonal, off centre", {0, 1, 0}, {1, 1, 1}, {1, 1, 0}, {0.2f, 0.999f, 0.2f}, {0, 1, 0}},
+      // The half with the foot of a 1 m panel standing upright on a floor: floor points 0.02 and 0.2 mm in front of it.
+      {"0.02 mm from a panel's foot", {-0.5f, 0, 0}, {0.5f, 0, 0}, {0.5f, 1, 0}, {0.1f, 0, 2e-5f}, {0, 1, 0}},
+      {"0.2 mm from a panel's foot", {-0.5f, 0, 0}, {0.5f, 0, 0}, {0.5f, 1, 0}, {-0.3f, 0, 2e-4f}, {0, 1, 0}},
+      // A flat triangle 2 m by 2 mm, 1 mm and 0.2 mm under it, between its two far corners.
+      {"1 mm under a flat triangle", {-1, 1, 0}, {0, 1, 0.002f}, {1, 1, 0}, {0, 0.999f, 0.001f}, {0, 1, 0}},
+      {"0.2 mm under a flat triangle", {-1, 1, 0}, {0, 1, 0.002f}, {1, 1, 0}, {0, 0.9998f, 0.001f}, {0, 1, 0}},
+  };
+  for (const lamp_case& c : cases)
+    for (int k = 0; k < 3; k++) {
+      vec3f p[3] = {c.c0, c.c1, c.c2};
+      one_triangle t(p[k], p[(k + 1) % 3], p[(k + 2) % 3], true);
+      double exact = lambert_irradiance(to_d(c.x), to_d(c.n), t.corner(0), t.corner(1), t.corner(2), 1.0);
+      INFO(c.name << ", corners from " << k << ": exact " << exact);
+      REQUIRE(spherical_solid_angle(t.scene, 0, c.x) > 0);
+      mean_se m = irradiance_estimate(t, c.x, c.n, 200000, uint64_t(31 + k));
+      INFO("estimate " << m.mean << " +- " << m.se);
+      CHECK(m.se < 0.01 * exact);
+      CHECK(std::fabs(m.mean - exact) < 4.4 * m.se);
+    }
 }
