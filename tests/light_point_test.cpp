@@ -246,7 +246,7 @@ TEST_CASE("solid-angle sampling takes the triangles a point sees large, and only
   CHECK(area > 1000);
   // The tangents the rule compares belong to the thresholds.
   CHECK(std::tan(0.5 * double(spherical_min_solid_angle)) == Approx(spherical_min_tan_half).epsilon(1e-6));
-  CHECK(std::tan(M_PI - 0.5 * double(spherical_max_solid_angle)) == Approx(spherical_max_cot_half).epsilon(1e-4));
+  CHECK(std::tan(0.5 * double(spherical_max_gap)) == Approx(spherical_max_cot_half).epsilon(1e-6));
 }
 
 TEST_CASE("a one-sided triangle sampled by solid angle gives nothing behind it", "[lights]") {
@@ -267,13 +267,13 @@ TEST_CASE("a one-sided triangle sampled by solid angle gives nothing behind it",
 
 TEST_CASE("irradiance near a large triangle: solid-angle samples match Lambert's formula with far less noise",
           "[lights]") {
-  // A floor point 2 cm under a 1.6 m triangle lamp and one beside it: the mean of le cos / pdf over samples must
-  // match the closed form, sampling by solid angle and (the same triangle seen from afar, scaled) by area alike;
-  // and by solid angle with a standard error a tenth of the area sampler's at the same count.
+  // A floor point 2 cm under a 1.6 m triangle lamp, one beside it and one 0.2 mm under it (6.28 sr, near the upper
+  // threshold): the mean of le cos / pdf over samples must match the closed form, sampling by solid angle and (at
+  // the first two) by area alike, and by solid angle with a standard error a tenth of the area sampler's.
   const vec3f p0 = {-0.8f, 0.02f, -0.6f}, p1 = {0.9f, 0.02f, -0.5f}, p2 = {0.0f, 0.02f, 0.9f};
   one_triangle tri(p0, p1, p2, false, 3.0f);  // faces down
   const int samples = 40000;
-  for (vec3f x : {vec3f{0, 0, 0}, vec3f{0.5f, 0, 0.2f}}) {
+  for (vec3f x : {vec3f{0, 0, 0}, vec3f{0.5f, 0, 0.2f}, vec3f{0.1f, 0.0198f, 0.1f}}) {
     dvec n = {0, 1, 0};
     double exact = lambert_irradiance(to_d(x), n, tri.corner(0), tri.corner(1), tri.corner(2), 3.0);
     INFO("point " << x.x << " " << x.z << " solid angle "
@@ -298,6 +298,7 @@ TEST_CASE("irradiance near a large triangle: solid-angle samples match Lambert's
                   << " area " << ma.mean << " +- " << ma.se);
     CHECK(m.se < 0.01 * exact);
     CHECK(std::fabs(m.mean - exact) < 4.4 * m.se);
+    if (x.y > 0) continue;  // 0.2 mm under it, 40000 area samples have not met their heavy tail (mean 0.075 of 9.4)
     CHECK(std::fabs(ma.mean - exact) < 4.4 * ma.se);
     CHECK(m.se < 0.1 * ma.se);
   }
@@ -333,6 +334,42 @@ TEST_CASE("points on the line through two corners of a lamp get its irradiance, 
       mean_se m = irradiance_estimate(t, c.x, c.n, 200000, uint64_t(31 + k));
       INFO("estimate " << m.mean << " +- " << m.se);
       CHECK(m.se < 0.01 * exact);
+      CHECK(std::fabs(m.mean - exact) < 4.4 * m.se);
+    }
+}
+
+TEST_CASE("no solid-angle sample is lost beside a lamp's edge line", "[lights]") {
+  // Points a little outside the line through two corners, between them, at 0.1-0.3 of that offset above the plane:
+  // C' ran past C as u neared 1 (the float sine and cosine of the area), beyond the plane (pdf 0, lost) or off the
+  // triangle (a review: a sliver lost 0.8 % of its solid angle and 1.5 % of its irradiance; a right triangle 1e-4).
+  struct lamp_case {
+    const char* name;
+    vec3f c0, c1, c2, x;
+  };
+  const float a = 0.03f;
+  const lamp_case cases[] = {
+      {"beside a sliver's edge", {0, 0, 0}, {1, 0, 0}, {std::cos(a), std::sin(a), 0}, {0.35f, -1e-4f, 8.8e-6f}},
+      {"beside a right triangle's edge", {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.35f, -1e-6f, 1e-7f}},
+  };
+  const vec3f n = {0, 1, 0};
+  for (const lamp_case& c : cases)
+    for (int k = 0; k < 3; k++) {
+      vec3f p[3] = {c.c0, c.c1, c.c2};
+      one_triangle t(p[k], p[(k + 1) % 3], p[(k + 2) % 3], true);
+      double exact = lambert_irradiance(to_d(c.x), to_d(n), t.corner(0), t.corner(1), t.corner(2), 1.0);
+      INFO(c.name << ", corners from " << k << ": exact " << exact);
+      REQUIRE(spherical_solid_angle(t.scene, 0, c.x) > 0);
+      int lost = 0;
+      std::vector<double> e;
+      for (int s = 0; s < 400000; s++) {
+        vec2f u = uniform_pair(uint64_t(41 + k), uint64_t(s));
+        light_sample ls = sample_light_point(t.lights, t.scene, 0, c.x, u.x, u.y);
+        lost += !(ls.pdf > 0);
+        e.push_back(ls.pdf > 0 ? double(ls.le.x) * std::max(0.0f, dot(n, ls.wi)) / ls.pdf : 0.0);
+      }
+      mean_se m = mean_and_se(e);
+      INFO("estimate " << m.mean << " +- " << m.se << ", lost " << lost);
+      CHECK(lost == 0);
       CHECK(std::fabs(m.mean - exact) < 4.4 * m.se);
     }
 }
