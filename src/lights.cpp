@@ -75,7 +75,7 @@ dvec3 unit(dvec3 a) {
 
 // Triangle t as seen from x, in units of |p0 - x| (so that no product of lengths leaves double's range at any
 // scene scale): its corners' offsets from x (p0 - x and the edges e1, e2 as stored), and the same triangle with its
-// corners renamed cyclically for the warp (a: corner A's offset, e1 = B - A, e2 = C - A) so that the two whose
+// corners renamed cyclically for the warp (a: corner A's offset, ab = B - A, ac = C - A) so that the two whose
 // directions from x are the most nearly opposite are A and C, the pair Arvo's construction handles best (B and C'
 // then never meet head-on, and A B is never the long arc its formula divides by): with A and B opposite, in double,
 // 1e-4 below a quad's diagonal, the estimate was still 0.6 % high.
@@ -119,7 +119,7 @@ triangle_view view_of(const scene_data& scene, int t, vec3f x) {
   if (!(l[1] > 0 && l[2] > 0) || !std::isfinite(den) || !std::isfinite(w.triple)) return w;
   // omega = 2 atan2(|triple|, den), compared with the thresholds through their half-angle tangents first (the
   // arctangent only where solid-angle sampling is taken): omega >= min where den <= 0 (omega >= pi) or
-  // |triple| >= den tan(min / 2); omega <= max where den >= 0 or |triple| >= -den tan(pi - max / 2).
+  // |triple| >= den tan(min / 2); omega <= max where den >= 0 or |triple| >= -den tan(gap / 2) (gap = 2 pi - max).
   double y = std::fabs(w.triple);
   bool above_min = den <= 0 || y >= den * double(spherical_min_tan_half);
   bool below_max = den >= 0 || y >= -den * double(spherical_max_cot_half);
