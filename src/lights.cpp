@@ -241,8 +241,7 @@ light_sample sample_light_point(const light_data& l, const scene_data& scene, in
   if (cos_l < 0 && emits_both_sides(l, light)) cos_l = -cos_l;
   if (!(cos_l > 0)) return s;
   s.le = l.radiance[light];
-  float a = scene.tri_area[t];
-  s.pdf = a > 0 ? s.dist * s.dist / (cos_l * a) : 0;
+  s.pdf = triangle_area_pdf(scene.tri_area[t], s.dist, cos_l);
   return s;
 }
 

@@ -73,9 +73,15 @@ inline constexpr float spherical_min_tan_half = 0.050041708375538792f;
 inline constexpr float spherical_max_cot_half = 0.00050000004166667088f;
 
 // The solid angle under which x sees scene triangle t when it is to be sampled by solid angle from x (between
-// spherical_min_solid_angle and spherical_max_solid_angle), else 0. A function of x and t alone, so that sampling
-// and the pdf a BSDF hit evaluates for MIS always agree.
+// spherical_min_solid_angle and spherical_max_solid_angle, and x not within a sliver's width of two of its edge
+// lines: lights.cpp), else 0. A function of x and t alone, so that sampling and the pdf a BSDF hit evaluates for MIS
+// always agree.
 float spherical_solid_angle(const scene_data& scene, int t, vec3f x);
+
+// Solid-angle pdf of a uniform point on a triangle of area `area` at distance dist, emitter cosine cos_l > 0.
+inline float triangle_area_pdf(float area, float dist, float cos_l) {
+  return area > 0 ? dist * dist / (cos_l * area) : 0;
+}
 
 // Solid-angle pdf of sampling, from x, the point of triangle light `light` at distance dist whose emitter cosine is
 // cos_l (the emitting side's; 0 or less: none).
@@ -85,8 +91,7 @@ inline float triangle_light_pdf(const scene_data& scene, const light_data& light
   int t = lights.tri[light];
   float omega = spherical_solid_angle(scene, t, x);
   if (omega > 0) return 1 / omega;
-  float a = scene.tri_area[t];
-  return a > 0 ? dist * dist / (cos_l * a) : 0;
+  return triangle_area_pdf(scene.tri_area[t], dist, cos_l);
 }
 // Radiance an emissive triangle sends toward a ray that hit its front (front=true) or back side.
 inline bool emits_both_sides(const light_data& lights, int light) {

@@ -53,11 +53,6 @@ double lambert_irradiance(dvec x, dvec n, dvec p0, dvec p1, dvec p2, double le) 
   return 0.5 * le * std::fabs(sum);
 }
 
-vec2f uniform_pair(uint64_t seed, uint64_t i) {
-  auto r = draw_vertex(sample_key(seed, i, 0), 1);
-  return {r.u[0], r.u[1]};
-}
-
 // A scene of one emitting triangle (radiance le; two-sided or not) and nothing else.
 struct one_triangle {
   scene_data scene;

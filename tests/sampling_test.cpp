@@ -17,12 +17,6 @@ namespace {
 
 constexpr double alpha = 1e-3;  // chi-square significance level of every test here
 
-// Uniform pair number i of a seeded stream.
-vec2f uniform_pair(uint64_t seed, uint64_t i) {
-  auto r = draw_vertex(sample_key(seed, i, 0), 1);
-  return {r.u[0], r.u[1]};
-}
-
 // Chi-square test of a direction warp: histogram over (cos theta, phi) cells against the pdf integrated
 // over each cell by a midpoint rule (pdf is solid angle; d omega = d cos_theta d phi).
 double direction_pvalue(const std::function<vec3f(vec2f)>& warp, const std::function<float(vec3f)>& pdf,

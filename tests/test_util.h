@@ -4,6 +4,7 @@
 
 #include "math.h"
 #include "obj_io.h"
+#include "rng.h"
 
 #include <sys/wait.h>
 
@@ -84,6 +85,12 @@ inline mean_se mean_and_se(const std::vector<double>& v) {
   for (double x : v) var += (x - m) * (x - m);
   var /= double(v.size() - 1);
   return {m, std::sqrt(var / double(v.size()))};
+}
+
+// Uniform pair number i of a seeded stream (the renderer's own PCG32 keys; any seed, any i).
+inline vec2f uniform_pair(uint64_t seed, uint64_t i) {
+  auto r = draw_vertex(sample_key(seed, i, 0), 1);
+  return {r.u[0], r.u[1]};
 }
 
 // A fresh temporary directory, removed on destruction.
