@@ -147,10 +147,11 @@ triangle_view view_of(const scene_data& scene, int t, vec3f x) {
 // a x b, a x ac is a x c). Returns the unit direction, or zero where no valid one is left.
 dvec3 spherical_direction(const triangle_view& w, float u, float v) {
   dvec3 b = w.a + w.ab;
-  dvec3 A = unit(w.a), B = unit(b);
+  double la = length(w.a);
+  dvec3 A = w.a * (1 / la), B = unit(b);  // A as unit() gives it, |a| kept for the angle below
   dvec3 n_ab = cross(w.a, w.ab), n_ac = cross(w.a, w.ac);
   // The angle at A: between the planes through A and B and through A and C; |n_ab x n_ac| = |a| |a . (ab x ac)|.
-  double sin_part = length(w.a) * std::fabs(w.triple), cos_part = dot(n_ab, n_ac);
+  double sin_part = la * std::fabs(w.triple), cos_part = dot(n_ab, n_ac);
   double h = std::sqrt(sin_part * sin_part + cos_part * cos_part);
   if (!(h > 0)) return {};
   double sin_alpha = sin_part / h, cos_alpha = cos_part / h;
