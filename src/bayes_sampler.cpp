@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <new>
 #include <cmath>
 
 namespace bl {
@@ -579,7 +580,27 @@ void bayes_sampler::reserve_growth() {
   // Fine pairs stay within the budget, coarse pairs within as many again (region_grid's allowance).
   const size_t now = size_t(regions.pairs), cuts = regions.cut_nodes.size();
   const size_t most = now + 2 * size_t(std::max<int64_t>(regions.params.max_pairs, 0));
-  const size_t pairs = std::min(now + now / 2, most), entries = std::min(cuts + cuts / 2, most);
+  // Room for every pair the budget allows, where that stays within max_reserved_bytes of address space (the default
+  // budget: about 350 MB, of which only what the pairs use is ever touched): a column that outgrows its reservation is
+  // copied whole into fresh pages, and all of them at once took one pass 0.44 s (the real Cornell box with its light
+  // in 128 triangles, 128x96, as its regions reached the budget: half of a 2-second render's learning time). Beyond
+  // that, or where the address space is refused, half as much again as now (growth then copies now and then).
+  const size_t per_pair = sizeof(pair_moments) + 6 * sizeof(float) + 2 * sizeof(uint8_t) + 4 * sizeof(int) +
+                          (params.region_prior ? 0 : sizeof(pair_coeffs));
+  const size_t per_entry = 2 * sizeof(int) + 3 * sizeof(float) + sizeof(vec3f) + 2 * sizeof(double);
+  const bool all = most * per_pair + std::max(cuts, most) * per_entry <= max_reserved_bytes;
+  if (all) {
+    try {
+      reserve_columns(most, std::max(cuts, most));
+      return;
+    } catch (const std::bad_alloc&) {
+      // (strict overcommit: fall through to the smaller reservation)
+    }
+  }
+  reserve_columns(std::min(now + now / 2, most), std::min(cuts + cuts / 2, most));
+}
+
+void bayes_sampler::reserve_columns(size_t pairs, size_t entries) {
   for (std::vector<float>* v : {&stats.mu0, &stats.p1_folded, &stats.k_folded}) v->reserve(pairs);
   for (std::vector<float>* v : {&stats.w, &stats.w_cv, &stats.cv}) v->reserve(pairs + 4);
   stats.m.reserve(pairs);

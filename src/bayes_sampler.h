@@ -109,12 +109,15 @@ struct bayes_sampler {
   // Sizes the statistics for every region and sets the region-level prior means of the pairs of regions
   // [first_region, end) (a function of each region's box and cut only). Weights are refolded by the caller.
   void add_pairs(int first_region);
-  // Reserves the columns for the pairs and cut entries of the regions, and room for what passes may add (half as
-  // many again, within the pair budget; the data/ scenes add 0-24 %, the real Cornell box with its light in 128
-  // triangles 23 %): growing a column copies it and touches its new pages, a pause of tenths of a second for the
-  // million pairs of a scene with many lights, and the old and new copies add to the peak memory. Room never used
-  // costs little (untouched pages; the 10^6-emitter stress scene's peak grows by 1.4 %).
+  // Reserves the columns for the pairs and cut entries of the regions, and room for what passes may add: every pair
+  // the budget allows where that stays within max_reserved_bytes of address space, else half as many again (the
+  // data/ scenes add 0-24 % at 320x240, the real Cornell box with its light in 128 triangles 23 %, but 53 % at
+  // 128x96): growing a column copies it and touches its new pages, a pause of tenths of a second for the million
+  // pairs of a scene with many lights, and the old and new copies add to the peak memory. Room never used costs
+  // little (untouched pages are never mapped).
   void reserve_growth();
+  void reserve_columns(size_t pairs, size_t entries);
+  static constexpr size_t max_reserved_bytes = size_t(1) << 30;
   // Refolds the weights of the pairs whose inputs changed in a pass: the touched pairs, the pairs new since
   // `old_pairs`, and the children of coarse pairs whose p1 moved by more than the refold tolerance. Work scales
   // with the pass's records and the moved parents' children; where more than 1/16 of the parents moved (the first
