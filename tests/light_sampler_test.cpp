@@ -447,6 +447,34 @@ TEST_CASE("lazily refolded bayes weights stay within the refold tolerance of an 
   }
 }
 
+TEST_CASE("bayes statistics columns are not reallocated while passes add regions", "[samplers][bayes]") {
+  // Regions for every cell a sample asks for (min_samples 1) and paths of 3 segments (deep vertices ask for coarse
+  // cells): the pairs grow far past the set-up's, and no column may move (a move copies it whole: a pause of tenths of
+  // a second per million pairs, and both copies at once in the peak memory).
+  auto t = make_test_scene(false);
+  sampler_params sp;
+  sp.kind = sampler_kind::bayes;
+  sp.regions.min_samples = 1;
+  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+  auto& s = std::get<bayes_sampler>(ls);
+  const size_t pairs0 = s.stats.m.size(), entries0 = s.regions.cut_nodes.size();
+  const void* before[] = {s.stats.m.data(),           s.stats.mu0.data(),         s.stats.w.data(),
+                          s.stats.w_cv.data(),        s.stats.cv.data(),          s.stats.p1_folded.data(),
+                          s.regions.pair_node.data(), s.regions.pair_parent.data(), s.regions.cut_nodes.data()};
+  learn_passes(t->in, s, 6);
+  INFO("pairs " << pairs0 << " -> " << s.stats.m.size() << ", cut entries " << entries0 << " -> "
+                << s.regions.cut_nodes.size());
+  REQUIRE(s.stats.m.size() > 2 * pairs0);  // far past half as many again (the reservation before)
+  REQUIRE(s.regions.cut_nodes.size() > 2 * entries0);
+  const void* after[] = {s.stats.m.data(),           s.stats.mu0.data(),         s.stats.w.data(),
+                         s.stats.w_cv.data(),        s.stats.cv.data(),          s.stats.p1_folded.data(),
+                         s.regions.pair_node.data(), s.regions.pair_parent.data(), s.regions.cut_nodes.data()};
+  for (size_t i = 0; i < std::size(before); i++) {
+    INFO("column " << i);
+    CHECK(after[i] == before[i]);
+  }
+}
+
 TEST_CASE("a bayes cluster of several members weighs the sum of its members' weights after learning", "[samplers][bayes]") {
   // Small cuts with members: clusters of several members whose weights learn apart. After every pass the cluster
   // columns must hold exactly the in-order sums of their members' current weights (refold refreshes only the clusters
