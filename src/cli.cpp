@@ -56,7 +56,11 @@ struct render_options {
   std::string reference;
   std::string log;
   bool quiet = false;
-  region_params regions;
+  region_params regions = [] {
+    region_params r;
+    r.max_pairs = -1;  // auto (region_params::auto_pairs_per_pixel) unless --region-budget is given
+    return r;
+  }();
   bayes_params bayes;
   std::string bayes_pmf = "second-moment";
   std::string bayes_prior = "region";
@@ -502,7 +506,8 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "pixel-centre camera rays reach get theirs before the first pass)")
       ->check(CLI::Range(1, 1 << 30))->group(grp);
   r->add_option("--region-budget", o.regions.max_pairs,
-                "Most (region, cluster) pairs before coarser regions serve (default 1572864, at most 2^29)")
+                "Most (region, cluster) pairs before coarser regions serve (default: bayes 32 per pixel of the "
+                "image, at most 1572864; the others 1572864; at most 2^29)")
       // Pair offsets are int: fine and coarse pairs (each up to the budget) must stay below 2^31.
       ->check(CLI::Range(int64_t(1), int64_t(1) << 29))->group(grp);
   const char* bg = bayes_group;

@@ -55,6 +55,12 @@ region_state make_regions(const sampler_params& params, const render_inputs& in,
   // tracing most NEE events are at deep vertices and refined learning costs more time than it saves (README).
   if (rp.max_members < 0) rp.max_members = in.max_depth == 1 ? region_params::auto_members : 0;
   rp.max_members = members ? std::min(rp.max_members, max_cut_entries - 1) : 0;
+  if (rp.max_pairs < 0) {
+    const int64_t pixels = int64_t(in.camera.width) * in.camera.height;
+    rp.max_pairs = learned ? std::max<int64_t>(1, std::min(region_params::default_pairs,
+                                                           region_params::auto_pairs_per_pixel * pixels))
+                           : region_params::default_pairs;
+  }
   region_state s = make_region_state(in.scene->bounds, tree, in.lights->sun != invalid_id, rp);
   // The bound sampler reads only cuts: with one cut shared by all regions it needs no region but the root.
   if (s.shared_cut && !learned) return s;

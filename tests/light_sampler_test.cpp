@@ -447,6 +447,24 @@ TEST_CASE("lazily refolded bayes weights stay within the refold tolerance of an 
   }
 }
 
+TEST_CASE("the automatic region budget is 32 pairs per pixel for bayes, within the default", "[samplers][bayes]") {
+  for (int image : {16, 512}) {
+    auto t = make_test_scene(false, image);
+    t->in.max_depth = 1;  // members: a fine region holds many pairs, so the budget binds at 16x16
+    sampler_params sp;
+    sp.regions.max_pairs = -1;
+    sp.kind = sampler_kind::bayes;
+    light_sampler lb = make_light_sampler(sp, t->in, t->tree);
+    const region_state& r = std::get<bayes_sampler>(lb).regions;
+    const int64_t want = std::min<int64_t>(region_params::default_pairs, 32 * int64_t(image) * image);
+    CHECK(r.params.max_pairs == want);
+    CHECK(r.pairs <= 2 * want + r.pair_count[size_t(r.root)]);  // fine pairs, coarse ones as many again, the root
+    sp.kind = sampler_kind::bound;
+    light_sampler lo = make_light_sampler(sp, t->in, t->tree);
+    CHECK(std::get<bound_sampler>(lo).regions.params.max_pairs == region_params::default_pairs);
+  }
+}
+
 TEST_CASE("bayes statistics columns are not reallocated while passes add regions", "[samplers][bayes]") {
   // Regions for every cell a sample asks for (min_samples 1) and paths of 3 segments (deep vertices ask for coarse
   // cells): the pairs grow far past the set-up's, and no column may move (a move copies it whole: a pause of tenths of
