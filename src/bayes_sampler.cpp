@@ -12,8 +12,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <new>
 #include <cmath>
+#include <new>
 
 namespace bl {
 

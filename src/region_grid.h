@@ -32,12 +32,12 @@ struct region_params {
   static constexpr int auto_members = 128;  // the default in direct illumination (max depth 1); 0 in path tracing
   int min_samples = 16;            // NEE samples a fine cell must ask for before its region is created
   int fine_depth = 1;              // path vertices up to this depth use fine regions, deeper ones coarse regions
-  int64_t max_pairs = int64_t(3) << 19;  // memory budget in (region, cluster) pairs (1.5 M; see README); -1: auto_pairs
-  // The command line's default budget (max_pairs -1): for bayes at most auto_pairs_per_pixel pairs per pixel of the
-  // image, within the 1.5 M (a render of fewer than 49152 pixels learns more per pair and spends less between passes:
-  // README), for the other samplers 1.5 M.
-  static constexpr int64_t default_pairs = int64_t(3) << 19;
+  static constexpr int64_t default_pairs = int64_t(3) << 19;  // 1.5 M
+  // The command line's default budget (max_pairs -1, resolved by make_light_sampler): for bayes at most
+  // auto_pairs_per_pixel pairs per pixel of the image, within default_pairs (a render of fewer than 49152 pixels then
+  // learns more per pair and spends less between passes: README), for the other samplers default_pairs.
   static constexpr int64_t auto_pairs_per_pixel = 32;
+  int64_t max_pairs = default_pairs;  // memory budget in (region, cluster) pairs (see README); -1: automatic (above)
 };
 
 // Cluster id of the sun inside a cut (tree nodes are >= 0).
