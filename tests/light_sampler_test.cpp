@@ -19,6 +19,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <memory>
 #include <sstream>
@@ -450,7 +451,7 @@ TEST_CASE("lazily refolded bayes weights stay within the refold tolerance of an 
 TEST_CASE("the automatic region budget is 32 pairs per pixel for bayes, within the default", "[samplers][bayes]") {
   for (int image : {16, 512}) {
     auto t = make_test_scene(false, image);
-    t->in.max_depth = 1;  // members: a fine region holds many pairs, so the budget binds at 16x16
+    t->in.max_depth = 1;  // direct: fine regions are refined into members (many pairs each)
     sampler_params sp;
     sp.regions.max_pairs = -1;
     sp.kind = sampler_kind::bayes;
@@ -476,18 +477,20 @@ TEST_CASE("bayes statistics columns are not reallocated while passes add regions
   light_sampler ls = make_light_sampler(sp, t->in, t->tree);
   auto& s = std::get<bayes_sampler>(ls);
   const size_t pairs0 = s.stats.m.size(), entries0 = s.regions.cut_nodes.size();
-  const void* before[] = {s.stats.m.data(),           s.stats.mu0.data(),         s.stats.w.data(),
-                          s.stats.w_cv.data(),        s.stats.cv.data(),          s.stats.p1_folded.data(),
-                          s.regions.pair_node.data(), s.regions.pair_parent.data(), s.regions.cut_nodes.data()};
+  auto columns = [&s] {
+    return std::array<const void*, 9>{s.stats.m.data(),          s.stats.mu0.data(),        s.stats.w.data(),
+                                      s.stats.w_cv.data(),       s.stats.cv.data(),         s.stats.p1_folded.data(),
+                                      s.regions.pair_node.data(), s.regions.pair_parent.data(),
+                                      s.regions.cut_nodes.data()};
+  };
+  const auto before = columns();
   learn_passes(t->in, s, 6);
   INFO("pairs " << pairs0 << " -> " << s.stats.m.size() << ", cut entries " << entries0 << " -> "
                 << s.regions.cut_nodes.size());
   REQUIRE(s.stats.m.size() > 2 * pairs0);  // far past half as many again (the reservation before)
   REQUIRE(s.regions.cut_nodes.size() > 2 * entries0);
-  const void* after[] = {s.stats.m.data(),           s.stats.mu0.data(),         s.stats.w.data(),
-                         s.stats.w_cv.data(),        s.stats.cv.data(),          s.stats.p1_folded.data(),
-                         s.regions.pair_node.data(), s.regions.pair_parent.data(), s.regions.cut_nodes.data()};
-  for (size_t i = 0; i < std::size(before); i++) {
+  const auto after = columns();
+  for (size_t i = 0; i < before.size(); i++) {
     INFO("column " << i);
     CHECK(after[i] == before[i]);
   }
