@@ -585,13 +585,10 @@ void bayes_sampler::reserve_growth() {
   // copied whole into fresh pages, and all of them at once took one pass 0.44 s (the real Cornell box with its light
   // in 128 triangles, 128x96, as its regions reached the budget: half of a 2-second render's learning time). Beyond
   // that, or where the address space is refused, half as much again as now (growth then copies now and then).
-  const size_t per_pair = sizeof(pair_moments) + 6 * sizeof(float) + 2 * sizeof(uint8_t) + 4 * sizeof(int) +
-                          (params.region_prior ? 0 : sizeof(pair_coeffs));
-  const size_t per_entry = 2 * sizeof(int) + 3 * sizeof(float) + sizeof(vec3f) + 2 * sizeof(double);
-  const bool all = most * per_pair + std::max(cuts, most) * per_entry <= max_reserved_bytes;
-  if (all) {
+  const size_t entries = std::max(cuts, most);
+  if (reserve_columns(most, entries, true) <= max_reserved_bytes) {
     try {
-      reserve_columns(most, std::max(cuts, most));
+      reserve_columns(most, entries);
       return;
     } catch (const std::bad_alloc&) {
       // (strict overcommit: fall through to the smaller reservation)
@@ -600,22 +597,28 @@ void bayes_sampler::reserve_growth() {
   reserve_columns(std::min(now + now / 2, most), std::min(cuts + cuts / 2, most));
 }
 
-void bayes_sampler::reserve_columns(size_t pairs, size_t entries) {
-  for (std::vector<float>* v : {&stats.mu0, &stats.p1_folded, &stats.k_folded}) v->reserve(pairs);
-  for (std::vector<float>* v : {&stats.w, &stats.w_cv, &stats.cv}) v->reserve(pairs + 4);
-  stats.m.reserve(pairs);
-  if (!params.region_prior) stats.weight.reserve(pairs);
-  stats.scratch.seen.reserve(pairs);
-  stats.scratch.dirty.reserve(pairs);
-  child_link.reserve(pairs);
-  for (std::vector<int>* v : {&regions.pair_node, &regions.pair_slot, &regions.pair_parent}) v->reserve(pairs);
-  regions.cut_nodes.reserve(entries);
-  regions.member_begin.reserve(entries);
-  if (!regions.members) return;
-  for (std::vector<float>* v : {&stats.gw, &stats.gw_cv, &stats.gcv}) v->reserve(entries + 4);
-  stats.gcol.reserve(entries);
-  stats.gtot.reserve(entries);
-  stats.gtot_cv.reserve(entries);
+size_t bayes_sampler::reserve_columns(size_t pairs, size_t entries, bool count_only) {
+  size_t bytes = 0;
+  auto room = [&](auto& column, size_t n) {
+    bytes += n * sizeof(column[0]);
+    if (!count_only) column.reserve(n);
+  };
+  for (std::vector<float>* v : {&stats.mu0, &stats.p1_folded, &stats.k_folded}) room(*v, pairs);
+  for (std::vector<float>* v : {&stats.w, &stats.w_cv, &stats.cv}) room(*v, pairs + 4);
+  room(stats.m, pairs);
+  if (!params.region_prior) room(stats.weight, pairs);
+  room(stats.scratch.seen, pairs);
+  room(stats.scratch.dirty, pairs);
+  room(child_link, pairs);
+  for (std::vector<int>* v : {&regions.pair_node, &regions.pair_slot, &regions.pair_parent}) room(*v, pairs);
+  room(regions.cut_nodes, entries);
+  room(regions.member_begin, entries);
+  if (!regions.members) return bytes;
+  for (std::vector<float>* v : {&stats.gw, &stats.gw_cv, &stats.gcv}) room(*v, entries + 4);
+  room(stats.gcol, entries);
+  room(stats.gtot, entries);
+  room(stats.gtot_cv, entries);
+  return bytes;
 }
 
 void bayes_sampler::rebuild_posterior() {

@@ -116,7 +116,9 @@ struct bayes_sampler {
   // pairs of a scene with many lights, and the old and new copies add to the peak memory. Room never used costs
   // little (untouched pages are never mapped).
   void reserve_growth();
-  void reserve_columns(size_t pairs, size_t entries);
+  // Reserves every column that grows with the pairs or the cut entries for that many; returns the bytes that takes
+  // (count_only: only counts them).
+  size_t reserve_columns(size_t pairs, size_t entries, bool count_only = false);
   static constexpr size_t max_reserved_bytes = size_t(1) << 30;
   // Refolds the weights of the pairs whose inputs changed in a pass: the touched pairs, the pairs new since
   // `old_pairs`, and the children of coarse pairs whose p1 moved by more than the refold tolerance. Work scales
