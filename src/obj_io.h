@@ -20,10 +20,11 @@ namespace bl {
 extern const char* const degenerate_reason;
 
 // One OBJ material (MTL statement names in comments). Colours are linear RGB; a statement the MTL omits keeps
-// the default below.
+// the default below (Kd aside: see kd).
 struct material_data {
   std::string name;
-  vec3f kd = {0.8f, 0.8f, 0.8f};  // Kd diffuse albedo (multiplies kd_texture; 1 when map_Kd comes without Kd)
+  vec3f kd = {0.8f, 0.8f, 0.8f};  // Kd diffuse albedo, multiplies kd_texture (0.8: the default material's; a library
+                                  // material without Kd gets 0, or 1 when it has a map_Kd)
   vec3f ks = {0, 0, 0};           // Ks specular albedo of the normalized Phong lobe
   float ns = 1;                   // Ns Phong exponent (>= 0)
   vec3f ke = {0, 0, 0};           // Ke emitted radiance (non-zero: the triangle is an area light)

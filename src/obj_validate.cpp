@@ -511,9 +511,11 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
   if (transparent_line > 0)
     stderr_text() << "warning: " << path << ":" << transparent_line
                   << ": dissolve (d below 1 or Tr above 0) is not rendered, surfaces stay opaque; map_d cuts out\n";
-  // A map_Kd without Kd shows the texture as it is (Kd multiplies the texture, as the MTL format says).
+  // A material without Kd has no diffuse part (Kd 0, as tinyobjloader reads it: a lamp written with Ke alone does
+  // not also reflect, a lobe written with Ks and Ns alone stays a pure lobe), unless it has a map_Kd: then it shows
+  // the texture as it is (Kd multiplies the texture, as the MTL format says).
   for (size_t i = first; i < out.size(); i++)
-    if (!out[i].kd_map.empty() && !has_kd[i - first]) out[i].material.kd = {1, 1, 1};
+    if (!has_kd[i - first]) out[i].material.kd = out[i].kd_map.empty() ? vec3f{0, 0, 0} : vec3f{1, 1, 1};
   unknown.report(path);
 }
 

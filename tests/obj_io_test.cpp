@@ -343,7 +343,7 @@ TEST_CASE("a corner's empty trailing part is left out as if not written", "[obj]
   CHECK_THAT(load_error(dir.write("c.obj", head + "f 1/1/1/ 2 3\n")), Catch::Contains("c.obj:7: malformed face corner"));
 }
 
-TEST_CASE("materials read Kd Ks Ns and Ke and faces without one get the default", "[obj]") {
+TEST_CASE("materials read Kd Ks Ns and Ke (no Kd: 0) and faces without one get the default", "[obj]") {
   temp_dir dir;
   dir.write("m.mtl",
             "# comment\nnewmtl red\n  Kd 0.5 0.25 0.125 # inline comment\n\tKs 0.1\nNs 20\nKa 0 0 0\nillum 2\n"
@@ -356,6 +356,7 @@ TEST_CASE("materials read Kd Ks Ns and Ke and faces without one get the default"
   CHECK(m.materials[0].name == "lamp");
   CHECK(m.materials[0].ke.x == 10.0f);
   CHECK(m.materials[0].ke.z == 6.0f);
+  CHECK(is_black(m.materials[0].kd));  // no Kd: no diffuse part (tinyobjloader's reading), the lamp only emits
   CHECK(m.materials[1].name == "red");
   CHECK(m.materials[1].kd.y == 0.25f);
   CHECK(m.materials[1].ks.z == 0.1f);  // one value means grey
