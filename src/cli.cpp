@@ -249,8 +249,11 @@ int run_render(const render_options& o) {
   if (o.frames > 1 && (!o.checkpoint.empty() || !o.resume.empty()))
     throw usage_error("--checkpoint and --resume are not supported with --frames");
   warn_unused_options(o, {kind});
-  for (const std::string& out : outputs) check_output_path(frame_path(out, 0, animated));
-  if (!o.log.empty()) check_output_path(frame_path(o.log, 0, animated));
+  // Every frame's files (a folder that exists for frame 0 only would fail them after their renders).
+  for (int f = 0; f < std::max(1, o.frames); f++) {
+    for (const std::string& out : outputs) check_output_path(frame_path(out, f, animated));
+    if (!o.log.empty()) check_output_path(frame_path(o.log, f, animated));
+  }
   if (!o.checkpoint.empty()) check_output_path(o.checkpoint);
   std::string resume_bytes;
   if (!o.resume.empty()) resume_bytes = read_file(o.resume);

@@ -231,3 +231,24 @@ TEST_CASE("frames of a sun that does not move are rendered with a warning", "[an
   CHECK(moving.status == 0);
   CHECK(moving.output.find("warning") == std::string::npos);
 }
+
+TEST_CASE("every frame's output and log are checked before the first frame renders", "[animation]") {
+  // Only frame 0's files were checked up front: with a folder for frame 0 alone, every frame rendered, frame 0 was
+  // written and the others failed at the end.
+  anim_scene a;
+  std::string anim = a.scene("anim.json", sun_start, &sun_end);
+  std::filesystem::create_directory(a.dir / "d0");
+  auto out = run_bayeslight("render " + anim + " --frames 3 --spp 1 --quiet -o " + (a.dir / "d%d/x.pfm"));
+  CHECK(out.status == 1);
+  CHECK(out.output.find("d1") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(a.dir / "d0/x.pfm"));
+  std::filesystem::create_directory(a.dir / "f2.pfm");  // frame 2's output is a folder
+  auto dir = run_bayeslight("render " + anim + " --frames 3 --spp 1 --quiet -o " + (a.dir / "f%d.pfm"));
+  CHECK(dir.status == 1);
+  CHECK(dir.output.find("is a directory") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(a.dir / "f0.pfm"));
+  auto log = run_bayeslight("render " + anim + " --frames 3 --spp 1 --quiet -o " + (a.dir / "g%d.pfm") + " --log " +
+                            (a.dir / "d%d/l.csv"));
+  CHECK(log.status == 1);
+  CHECK_FALSE(std::filesystem::exists(a.dir / "g0.pfm"));
+}
