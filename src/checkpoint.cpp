@@ -18,8 +18,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos; 5: mean hierarchy (k_folded);
 // 6: bayes fallback check; 7: no point-prior weights in region-prior mode; 8: the stratified set's first sample;
 // 9: members; 10: reversed twin faces (a ray meets the one turned toward it); 11: hashed per-vertex PCG32 seeds; 12: the
-// reference's hash
-constexpr uint32_t version = 12;
+// reference's hash; 13: the region options as resolved in the fingerprint, Kd 0 for a library material without one
+constexpr uint32_t version = 13;
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -332,7 +332,9 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   const bool regions = k == sampler_kind::bound || k == sampler_kind::donikian || k == sampler_kind::bayes;
   if (k == sampler_kind::donikian || k == sampler_kind::bayes) h.value(p.pass_weighting);  // the adaptive ones
   if (regions) {
-    const region_params& r = p.sampler.regions;
+    // As the render resolves them: a default given explicitly (--cut-members 128 in direct illumination, the automatic
+    // pair budget) renders the same image and was refused as a different render.
+    const region_params r = effective_region_params(p.sampler, p.max_depth, int64_t(p.width) * p.height);
     h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
     h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
     h.value(r.max_members);

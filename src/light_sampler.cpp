@@ -45,30 +45,33 @@ std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_g
 }
 
 // Regions of a cut-based sampler: the grid, the root, and the regions of directly visible surfaces.
-// `learned`: whether the sampler keeps statistics per region (bayes), so that regions matter even with a shared
-// cut; `members`: whether clusters are refined into learned members (bayes with the region prior only).
-region_state make_regions(const sampler_params& params, const render_inputs& in, const light_tree_data& tree,
-                          bool learned, bool members = false) {
-  region_params rp = params.regions;
-  rp.max_cut = std::min(std::max(rp.max_cut, 1), max_cut_entries - 1);
-  // Members by default in direct illumination only: there NEE at the first hit is the whole estimate, while in path
-  // tracing most NEE events are at deep vertices and refined learning costs more time than it saves (README).
-  if (rp.max_members < 0) rp.max_members = in.max_depth == 1 ? region_params::auto_members : 0;
-  rp.max_members = members ? std::min(rp.max_members, max_cut_entries - 1) : 0;
-  if (rp.max_pairs < 0) {
-    const int64_t pixels = int64_t(in.camera.width) * in.camera.height;
-    rp.max_pairs = learned ? std::max<int64_t>(1, std::min(region_params::default_pairs,
-                                                           region_params::auto_pairs_per_pixel * pixels))
-                           : region_params::default_pairs;
-  }
+region_state make_regions(const sampler_params& params, const render_inputs& in, const light_tree_data& tree) {
+  const region_params rp = effective_region_params(params, in.max_depth, int64_t(in.camera.width) * in.camera.height);
   region_state s = make_region_state(in.scene->bounds, tree, in.lights->sun != invalid_id, rp);
   // The bound sampler reads only cuts: with one cut shared by all regions it needs no region but the root.
-  if (s.shared_cut && !learned) return s;
+  if (s.shared_cut && params.kind != sampler_kind::bayes) return s;
   add_regions(s, tree, camera_region_keys(in, s.grid));
   return s;
 }
 
 }  // namespace
+
+region_params effective_region_params(const sampler_params& params, int max_depth, int64_t pixels) {
+  region_params rp = params.regions;
+  rp.max_cut = std::min(std::max(rp.max_cut, 1), max_cut_entries - 1);
+  // Statistics per region (bayes) make regions matter even with a shared cut; its members (with the region prior
+  // only) are learned refinements of the clusters.
+  const bool learned = params.kind == sampler_kind::bayes, members = learned && params.bayes.region_prior;
+  // Members by default in direct illumination only: there NEE at the first hit is the whole estimate, while in path
+  // tracing most NEE events are at deep vertices and refined learning costs more time than it saves (README).
+  if (rp.max_members < 0) rp.max_members = max_depth == 1 ? region_params::auto_members : 0;
+  rp.max_members = members ? std::min(rp.max_members, max_cut_entries - 1) : 0;
+  if (rp.max_pairs < 0)
+    rp.max_pairs = learned ? std::max<int64_t>(1, std::min(region_params::default_pairs,
+                                                           region_params::auto_pairs_per_pixel * pixels))
+                           : region_params::default_pairs;
+  return rp;
+}
 
 const char* sampler_name(sampler_kind kind) {
   switch (kind) {
@@ -118,7 +121,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.lights = &lights;
       s.sun_sin = sun_sin;
       s.sun_cos = sun_cos;
-      s.regions = make_regions(params, in, tree, false);
+      s.regions = make_regions(params, in, tree);
       return s;
     }
     case sampler_kind::donikian: {
@@ -127,9 +130,8 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       b.lights = &lights;
       b.sun_sin = sun_sin;
       b.sun_cos = sun_cos;
-      b.regions = make_regions(params, in, tree, false);
-      region_params rp = params.regions;
-      rp.max_cut = std::min(std::max(rp.max_cut, 1), max_cut_entries - 1);
+      b.regions = make_regions(params, in, tree);
+      const region_params rp = b.regions.params;
       return make_donikian_sampler(tree, lights, std::move(b), in.camera.width, in.camera.height, params.donikian, rp,
                                    in.scene->bounds);
     }
@@ -146,7 +148,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.power = power_sampler{make_discrete(lights.power.data(), lights.count)};
       if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
         s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);
-      s.regions = make_regions(params, in, tree, true, s.params.region_prior);
+      s.regions = make_regions(params, in, tree);
       s.reserve_growth();
       s.add_pairs(0);
       refresh_weights(s.stats, &s.regions.pair_parent, s.params);

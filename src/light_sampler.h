@@ -34,6 +34,11 @@ struct sampler_params {
 // Whether a sampler kind uses the light tree.
 bool needs_light_tree(sampler_kind kind);
 
+// The region options a render of `params.kind` uses (bound, donikian, bayes): --max-cut within max_cut_entries,
+// members only for bayes with the region prior (automatic: 128 in direct illumination, max_depth 1, else none), the
+// automatic pair budget resolved for an image of `pixels` pixels. Two renders with equal results regionize alike.
+region_params effective_region_params(const sampler_params& params, int max_depth, int64_t pixels);
+
 // Builds the sampler of `params.kind`; `tree` must outlive it. Region-based samplers discover the regions of the
 // camera's first hits up front (one ray per pixel centre). Throws usage_error for a kind this build lacks.
 light_sampler make_light_sampler(const sampler_params& params, const render_inputs& in, const light_tree_data& tree);

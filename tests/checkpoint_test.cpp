@@ -302,6 +302,34 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
 
 }  // namespace
 
+TEST_CASE("resuming with an option's automatic value given explicitly is accepted", "[checkpoint]") {
+  // The fingerprint held the options as given: --cut-members 128 in direct illumination (its automatic value), the
+  // automatic pair budget written out, or --cut-members with bound (which has no members) were refused as another
+  // render, though they render the same bytes. What each option resolves to is checked instead.
+  struct variant {
+    const char* scene;
+    const char* sampler;
+    std::string same;   // the automatic values, given explicitly (40 x 30: bayes's budget is 32 x 1200 pairs)
+    std::string other;  // a value that changes the render
+  };
+  for (const variant& v : {variant{"direct", "bayes", " --cut-members 128 --region-budget 38400", " --cut-members 64"},
+                           variant{"path", "bayes", " --cut-members 0", " --region-budget 38399"},
+                           variant{"direct", "bound", " --cut-members 5 --region-budget 1572864", " --max-cut 32"}}) {
+    temp_dir d;
+    const std::string args = "render " + source_path(std::string("data/living_room/") + v.scene + ".json") +
+                             " --sampler " + v.sampler + " --width 40 --height 30 --spp 27 --quiet";
+    std::string ck = d / "ck.bin", full = d / "full.pfm", part = d / "part.pfm";
+    INFO(v.scene << " " << v.sampler);
+    REQUIRE(run_bayeslight(args + " -o " + full).status == 0);
+    REQUIRE(run_bayeslight(args + " -o " + part + " --checkpoint " + ck + " --stop-after-passes 5").status == 130);
+    auto r = run_bayeslight(args + v.same + " -o " + part + " --resume " + ck);
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    CHECK(read_file(part) == read_file(full));
+    CHECK(run_bayeslight(args + v.other + " -o " + part + " --resume " + ck).status == 3);
+  }
+}
+
 TEST_CASE("the checkpoint fingerprint sees every texture option of every material", "[checkpoint]") {
   // -s, -o and -clamp change the image: a checkpoint of one must not resume with another.
   camera_params cam;
