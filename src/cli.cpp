@@ -494,8 +494,9 @@ void add_render_options(CLI::App* r, render_options& o) {
       ->check(CLI::Range(0.0, 100.0))->check(finite_number)->group(grp);
   r->add_option("--cut-members", o.regions.max_members,
                 "bayes: clusters of a region's cut are refined into at most this many members in all, each learned "
-                "apart and chosen inside its cluster (default 128 with --max-depth 1, else 0; 0 or at most the cut "
-                "size: none refined; at most 1024)")
+                "apart and chosen inside its cluster (default 128 with --max-depth 1, else 0; at most 1024). Any count "
+                "also lets a fine cluster learn from the coarse cluster holding it (0: only from one of the same "
+                "node), so a count that refines nothing (at most the cut size) still differs a little from 0")
       ->check(CLI::Range(0, 1024))->group(grp);
   r->add_option("--shared-cut-lights", o.regions.shared_cut_lights,
                 "Scenes with at most this many lights give every region a cut of all lights, no clustering (default 16; "
