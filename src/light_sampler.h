@@ -36,7 +36,8 @@ bool needs_light_tree(sampler_kind kind);
 
 // The region options a render of `params.kind` uses (bound, donikian, bayes): --max-cut within max_cut_entries,
 // members only for bayes with the region prior (automatic: 128 in direct illumination, max_depth 1, else none), the
-// automatic pair budget resolved for an image of `pixels` pixels. Two renders with equal results regionize alike.
+// automatic pair budget resolved for an image of `pixels` pixels (what a checkpoint's fingerprint compares: options
+// that resolve alike render alike).
 region_params effective_region_params(const sampler_params& params, int max_depth, int64_t pixels);
 
 // Builds the sampler of `params.kind`; `tree` must outlive it. Region-based samplers discover the regions of the
