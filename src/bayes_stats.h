@@ -217,16 +217,31 @@ inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p)
   // Only for clusters the region nearly always sees: where visibility is mixed it is usually a function of
   // position (a shadow edge through the region), and a region-wide mean would add, not remove, variance.
   bool cv = p.second_moment && p1 >= p.cv_min_visible && pair_posterior(s, i, p, mu0, k, h);
-  // Residual second moment E[(Z - c)^2] with c = p1 k: p1 (k^2 + h) - p1^2 k^2 = p1 h + p1 (1 - p1) k^2.
-  double w_cv = cv ? std::sqrt(p1 * h + p1 * (1 - p1) * k * k) : 0.0;
-  if (!cv || !(w_cv <= max_pair_weight && p1 * k <= max_pair_weight)) {
+  // The control variate's mean of z, cm: the posterior mean k, but never above the mean of the samples themselves
+  // (the pair's own, or where it has none its parent's), and none where neither has a sample. A prior mean alone
+  // can be far too large (a bound is an upper limit: a lamp facing a ceiling 1 mm away, which the rest of the
+  // ceiling sees edge-on, has a bound there 10^4 times its contribution), and c_j from it made every estimate
+  // (sum_j c_j - c_J / P_J + Y_J / P_J) noisier, there 100 times more than without control variates. Any c is
+  // unbiased.
+  double cm = k;
+  if (cv) {
+    if (s.m[i].n1 > 0) cm = std::min(k, s.m[i].mean);
+    else if (up >= 0 && s.m[size_t(up)].n1 > 0) cm = std::min(k, s.m[size_t(up)].mean);
+    else cv = false;
+  }
+  // Residual second moment E[(Z - c)^2] with c = p1 cm: p1 (k^2 + h) - 2 p1^2 cm k + p1^2 cm^2, which for cm = k is
+  // p1 h + p1 (1 - p1) k^2.
+  double w_cv = !cv ? 0.0
+                : cm == k ? std::sqrt(p1 * h + p1 * (1 - p1) * k * k)
+                          : std::sqrt(std::max(p1 * (k * k + h) - 2 * p1 * p1 * cm * k + p1 * p1 * cm * cm, 0.0));
+  if (!cv || !(w_cv <= max_pair_weight && p1 * cm <= max_pair_weight)) {
     s.w_cv[i] = s.w[i];  // no learned mean (or the mean-only ablation, or one beyond float): no control variate
     s.cv[i] = 0;
     return;
   }
   if (mu0 > 0 && w_cv < min_pair_weight) w_cv = min_pair_weight;  // (the naive ablation's is 0 after one sample)
   s.w_cv[i] = float(w_cv);
-  s.cv[i] = float(p1 * k);
+  s.cv[i] = float(p1 * cm);
 }
 // Whether pair i's statistics and what sampling reads of it (its weight columns where the mode keeps them) are finite.
 inline bool pair_state_finite(const bayes_stats& s, size_t i) {
