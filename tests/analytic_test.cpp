@@ -34,7 +34,7 @@ std::vector<double> render_pixels(mesh_data mesh, const camera_params& cam, cons
   p.threads = 2;
   p.sampler.kind = kind;
   render_result r = render(scene, bvh, lights, p);
-  std::vector<double> red;  // the film's own mean (film_image would clamp values below zero)
+  std::vector<double> red;  // the film's own mean, in double
   for (int i = 0; i < size * size; i++) red.push_back(r.film[3 * size_t(i)] / r.film_weight);
   return red;
 }

@@ -51,8 +51,7 @@ camera_params looking_down(vec3f eye, vec3f target, float fov) {
   return c;
 }
 
-// Per-pixel luminance of a render's film: the estimator's own mean, before film_image clamps negative values (the
-// comparisons below test the estimator's unbiasedness, which a clamp near zero would blur).
+// Per-pixel luminance of a render's film: the estimator's own mean, in double (film_image writes it rounded to float).
 std::vector<double> pixel_luminance(const render_result& r) {
   std::vector<double> out;
   for (size_t i = 0; i < r.film.size(); i += 3)
