@@ -33,7 +33,7 @@ struct region_params {
   int min_samples = 16;            // NEE samples a fine cell must ask for before its region is created
   int fine_depth = 1;              // path vertices up to this depth use fine regions, deeper ones coarse regions
   static constexpr int64_t default_pairs = int64_t(3) << 19;  // 1.5 M
-  // The command line's default budget (max_pairs -1, resolved by make_light_sampler): for bayes at most
+  // The command line's default budget (max_pairs -1, resolved by effective_region_params): for bayes at most
   // auto_pairs_per_pixel pairs per pixel of the image, within default_pairs (a render of fewer than 49152 pixels then
   // learns more per pair and spends less between passes: README), for the other samplers default_pairs.
   static constexpr int64_t auto_pairs_per_pixel = 32;
