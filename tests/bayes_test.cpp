@@ -15,6 +15,7 @@
 #include "light_sampler.h"
 #include "rng.h"
 #include "scene.h"
+#include "scene_fixture.h"
 #include "test_util.h"
 
 using namespace bl;
@@ -28,15 +29,16 @@ pair_weight weight_of(const bayes_stats& s, size_t i, const bayes_params& p) {
   return folded_coeffs(s, i, own_p1(s, i, p), p);
 }
 
-double unif(pcg32& r) {
+// Uniform in [0, 1) with 53 random bits, and log-uniform in [lo, hi), in double precision.
+double unif64(pcg32& r) {
   return (double(r() >> 5) * 67108864.0 + double(r() >> 6)) * (1.0 / 9007199254740992.0);
 }
-double log_uniform(pcg32& r, double lo, double hi) {
-  return lo * std::pow(hi / lo, unif(r));
+double log_uniform64(pcg32& r, double lo, double hi) {
+  return lo * std::pow(hi / lo, unif64(r));
 }
 // Standard normal (Box-Muller).
 double normal(pcg32& r) {
-  double u1 = 1 - unif(r), u2 = unif(r);
+  double u1 = 1 - unif64(r), u2 = unif64(r);
   return std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
 }
 
@@ -133,7 +135,7 @@ std::vector<bayes_params> param_sets() {
 std::vector<double> synthetic(pcg32& r, int n, double p0, double k, double h, double d) {
   std::vector<double> y;
   for (int i = 0; i < n; i++) {
-    if (unif(r) < p0)
+    if (unif64(r) < p0)
       y.push_back(0);
     else
       y.push_back(std::fabs(k + std::sqrt(h) * normal(r)) / (d * d));
@@ -142,13 +144,6 @@ std::vector<double> synthetic(pcg32& r, int n, double p0, double k, double h, do
 }
 
 // A floor lit by `lamps` small lamps of different radiance and height (plus a sun), and everything a sampler needs.
-struct test_scene {
-  scene_data scene;
-  bvh_data bvh;
-  light_data lights;
-  light_tree_data tree;
-  render_inputs in;
-};
 std::unique_ptr<test_scene> make_scene(int lamps, bool sun) {
   mesh_builder b;
   int floor = b.add_material({0.5f, 0.5f, 0.5f});
@@ -159,26 +154,8 @@ std::unique_ptr<test_scene> make_scene(int lamps, bool sun) {
     float x = -6 + 12 * float(i) / float(std::max(1, lamps - 1)), y = 1 + float(i % 3), z = float(i % 4) - 1.5f;
     b.add_quad({x, y, z}, {x + 0.3f, y, z}, {x + 0.3f, y, z + 0.3f}, {x, y, z + 0.3f}, m);
   }
-  auto t = std::make_unique<test_scene>();
-  camera_params cam;
-  cam.automatic = false;
-  cam.eye = {0, 8, 8};
-  cam.target = {0, 0, 0};
-  cam.fov_y_deg = 60;
-  sun_params sp;
-  if (sun) {
-    sp.enabled = true;
-    sp.direction = normalize(vec3f{-0.4f, 1, 0.3f});
-    sp.irradiance = {2, 2, 2};
-  }
-  t->scene = build_scene(std::move(b.mesh), cam, sp, false, 1.0f);
-  t->bvh = build_bvh(t->scene);
-  t->lights = build_lights(t->scene);
-  t->tree = build_light_tree(t->lights, t->scene);
-  t->in.scene = &t->scene;
-  t->in.bvh = &t->bvh;
-  t->in.lights = &t->lights;
-  t->in.camera = make_camera(t->scene.camera, 8, 8);
+  auto t = build_test_scene(std::move(b.mesh), fixed_camera({0, 8, 8}, {0, 0, 0}, 60),
+                             sun ? test_sun({-0.4f, 1, 0.3f}, {2, 2, 2}) : sun_params{});
   t->in.max_depth = 1;
   return t;
 }
@@ -338,10 +315,10 @@ TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes
     resize_stats(s, pairs, p);
     std::vector<bayes_row> rows(3);
     for (int i = 0; i < pairs; i++) {
-      int n = i % 10 == 0 ? 0 : int(log_uniform(rng, 1, 3000));
-      double p0 = unif(rng), zs = log_uniform(rng, 1e-12, 1e12), cv = log_uniform(rng, 1e-3, 3);
+      int n = i % 10 == 0 ? 0 : int(log_uniform64(rng, 1, 3000));
+      double p0 = unif64(rng), zs = log_uniform64(rng, 1e-12, 1e12), cv = log_uniform64(rng, 1e-3, 3);
       for (int k = 0; k < n; k++) {
-        double z = unif(rng) < p0 ? 0.0 : zs * std::fabs(1 + cv * normal(rng));
+        double z = unif64(rng) < p0 ? 0.0 : zs * std::fabs(1 + cv * normal(rng));
         rows[size_t(rng(3))].add(i, z);
       }
     }
@@ -351,7 +328,7 @@ TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes
     double worst = 0;
     for (int i = 0; i < pairs; i++)
       for (int k = 0; k < 20; k++) {
-        double bound = log_uniform(rng, 1e-8, 1e8), scale = log_uniform(rng, 0.01, 1), d = log_uniform(rng, 1e-3, 1e3);
+        double bound = log_uniform64(rng, 1e-8, 1e8), scale = log_uniform64(rng, 0.01, 1), d = log_uniform64(rng, 1e-3, 1e3);
         double v = scale * bound, g = 1 / (d * d);
         double fast = eval_weight(weight_of(s, size_t(i), p), p, v, g);
         double ref =
@@ -374,7 +351,7 @@ TEST_CASE("prior only weights are proportional to the bound", "[bayes]") {
     double ratio = eval_weight(weight_of(s, 0, p), p, 1.0, 1.0);
     CHECK(ratio > 0);
     for (int k = 0; k < 200; k++) {
-      double v = log_uniform(rng, 1e-10, 1e10), g = log_uniform(rng, 1e-6, 1e6);
+      double v = log_uniform64(rng, 1e-10, 1e10), g = log_uniform64(rng, 1e-6, 1e6);
       CHECK(rel_err(eval_weight(weight_of(s, size_t(k % 5), p), p, v, g), ratio * v) < 1e-12);
       double d = 1 / std::sqrt(g);
       CHECK(rel_err(posterior_weight(p, v, 1.0, d, 0, 0, 0, 0), ratio * v) < 1e-6);  // float coefficient
@@ -402,8 +379,8 @@ TEST_CASE("a bayes sampler without data picks clusters like the bound sampler", 
     int compared = 0;
     double worst = 0;
     for (int k = 0; k < 400; k++) {
-      vec3f p = {float(-9 + 18 * unif(rng)), 0, float(-9 + 18 * unif(rng))};
-      shade_point sp{p, {0, 1, 0}, float(0.1 + 0.8 * unif(rng)), 0, 1};
+      vec3f p = {float(-9 + 18 * unif64(rng)), 0, float(-9 + 18 * unif64(rng))};
+      shade_point sp{p, {0, 1, 0}, float(0.1 + 0.8 * unif64(rng)), 0, 1};
       sb.prepare(*cb, sp);
       sy.prepare(*cy, sp);
       REQUIRE(cb->count == cy->count);
@@ -435,10 +412,10 @@ TEST_CASE("with the region prior a bayes sampler without data weighs clusters by
     int compared = 0, behind = 0, in_front = 0;
     double worst = 0;
     for (int k = 0; k < 400; k++) {
-      vec3f p = {float(-9 + 18 * unif(rng)), float(4 * unif(rng)), float(-9 + 18 * unif(rng))};
+      vec3f p = {float(-9 + 18 * unif64(rng)), float(4 * unif64(rng)), float(-9 + 18 * unif64(rng))};
       // Random normals, many of them facing away from some lamps.
       vec3f n = normalize(vec3f{float(normal(rng)), float(normal(rng)), float(normal(rng))});
-      shade_point sp{p, n, float(0.1 + 0.8 * unif(rng)), 0, 1};
+      shade_point sp{p, n, float(0.1 + 0.8 * unif64(rng)), 0, 1};
       *cy = cut_context{};
       sy.prepare(*cy, sp);
       if (cy->count < 2) continue;
@@ -489,10 +466,10 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
   std::vector<std::vector<double>> obs(pairs);
   std::vector<std::pair<int, double>> stream;
   for (int i = 0; i < pairs; i++) {
-    double scale = log_uniform(rng, 1e-3, 1e3);
+    double scale = log_uniform64(rng, 1e-3, 1e3);
     int n = 1 + int(rng(400));
     for (int k = 0; k < n; k++) {
-      double z = unif(rng) < 0.3 ? 0.0 : scale * std::exp(0.5 * normal(rng));
+      double z = unif64(rng) < 0.3 ? 0.0 : scale * std::exp(0.5 * normal(rng));
       obs[size_t(i)].push_back(z);
     }
   }
@@ -635,7 +612,7 @@ convergence_result run_convergence(const bayes_params& params, const convergence
     for (int i = pass * n / 6; i < (pass + 1) * n / 6; i++)
       for (int j = 0; j < 3; j++) {
         float y = 0;
-        if (!(unif(rng) < cs.p0[j])) y = float(std::fabs(k[j] + std::sqrt(h[j]) * normal(rng)) * y_per_z[j]);
+        if (!(unif64(rng) < cs.p0[j])) y = float(std::fabs(k[j] + std::sqrt(h[j]) * normal(rng)) * y_per_z[j]);
         light_choice c;
         c.cluster = j;
         c.light = j;
@@ -942,7 +919,7 @@ TEST_CASE("control variates apply at unweighted NEE to nearly always visible clu
     for (int j = 0; j < 2; j++) {
       light_choice c;
       c.cluster = j;
-      float y = j == 0 ? float(0.3 * (1 + 0.05 * normal(rng))) : (unif(rng) < 0.5 ? 0.0f : 0.2f);
+      float y = j == 0 ? float(0.3 * (1 + 0.05 * normal(rng))) : (unif64(rng) < 0.5 ? 0.0f : 0.2f);
       s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
     }
   }

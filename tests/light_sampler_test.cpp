@@ -14,6 +14,7 @@
 #include "render.h"
 #include "rng.h"
 #include "scene.h"
+#include "scene_fixture.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
@@ -34,26 +35,7 @@ constexpr double alpha = 1e-3;     // chi-square significance level of every fre
 constexpr double sum_tol = 1e-5;   // tolerance of sum(pmf) = 1 (float cdfs and products of a few factors)
 constexpr int chi2_samples = 100000;
 
-float unif(pcg32& r) { return uint_to_unit(r()); }
-float log_uniform(pcg32& r, float lo, float hi) { return lo * std::pow(hi / lo, unif(r)); }
-vec3f random_unit(pcg32& r) {
-  float z = 1 - 2 * unif(r), phi = 2 * pi_f * unif(r);
-  float s = safe_sqrt(1 - z * z);
-  return {s * std::cos(phi), s * std::sin(phi), z};
-}
-vec3f random_in(pcg32& r, vec3f lo, vec3f hi) {
-  return {lo.x + (hi.x - lo.x) * unif(r), lo.y + (hi.y - lo.y) * unif(r), lo.z + (hi.z - lo.z) * unif(r)};
-}
 bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
-// The test scene, its acceleration structure and lights (heap-held: bvh_data and render_inputs point into it).
-struct test_scene {
-  scene_data scene;
-  bvh_data bvh;
-  light_data lights;
-  light_tree_data tree;
-  render_inputs in;
-};
 
 // A floor, a back wall and an occluding box, lit by 36 small emitters whose radiance spans 1e-3..1e4: most face
 // down (randomly tilted), a quarter face up (away from the floor: they light only the ceiling-less void), plus
@@ -76,26 +58,8 @@ std::unique_ptr<test_scene> make_test_scene(bool sun, int image = 16) {
     if (i % 4 == 3) std::swap(p1, p2);  // faces up
     b.add_triangle(p0, p1, p2, m);
   }
-  auto t = std::make_unique<test_scene>();
-  camera_params cam;
-  cam.automatic = false;
-  cam.eye = {0, 6, 14};
-  cam.target = {0, 1, 0};
-  cam.fov_y_deg = 50;
-  sun_params sp;
-  if (sun) {
-    sp.enabled = true;
-    sp.direction = normalize(vec3f{0.3f, 1.0f, 0.2f});
-    sp.irradiance = {5, 5, 4};
-  }
-  t->scene = build_scene(std::move(b.mesh), cam, sp, false, 1.0f);
-  t->bvh = build_bvh(t->scene);
-  t->lights = build_lights(t->scene);
-  t->tree = build_light_tree(t->lights, t->scene);
-  t->in.scene = &t->scene;
-  t->in.bvh = &t->bvh;
-  t->in.lights = &t->lights;
-  t->in.camera = make_camera(t->scene.camera, image, image);
+  auto t = build_test_scene(std::move(b.mesh), fixed_camera({0, 6, 14}, {0, 1, 0}, 50),
+                             sun ? test_sun({0.3f, 1.0f, 0.2f}, {5, 5, 4}) : sun_params{}, image);
   t->in.max_depth = 3;
   t->in.seed = 5;
   return t;
@@ -773,19 +737,7 @@ TEST_CASE("a light with a tiny share of the selection weight keeps a non zero pm
   lamp(3, 0, dim);
   lamp(0, 1.5f, dim);
   lamp(0, -1.5f, bright);
-  auto t = std::make_unique<test_scene>();
-  camera_params cam;
-  cam.automatic = false;
-  cam.eye = {0, 5, 5};
-  cam.target = {0, 0, 0};
-  t->scene = build_scene(std::move(b.mesh), cam, sun_params{}, false, 1.0f);
-  t->bvh = build_bvh(t->scene);
-  t->lights = build_lights(t->scene);
-  t->tree = build_light_tree(t->lights, t->scene);
-  t->in.scene = &t->scene;
-  t->in.bvh = &t->bvh;
-  t->in.lights = &t->lights;
-  t->in.camera = make_camera(t->scene.camera, 8, 8);
+  auto t = build_test_scene(std::move(b.mesh), fixed_camera({0, 5, 5}, {0, 0, 0}));
   std::vector<shade_point> pts;
   for (float x : {-1.0f, 0.0f, 0.7f})
     for (float z : {-0.5f, 0.3f}) pts.push_back(shade_point{{x, 0, z}, {0, 1, 0}, 0.5f, 0, 1});

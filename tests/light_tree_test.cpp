@@ -9,6 +9,7 @@
 #include "rng.h"
 #include "sampling.h"
 #include "scene.h"
+#include "scene_fixture.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
@@ -24,17 +25,6 @@ using namespace bl::test;
 namespace {
 
 constexpr double alpha = 1e-3;  // chi-square significance level of every test here
-
-float unif(pcg32& r) { return uint_to_unit(r()); }
-float log_uniform(pcg32& r, float lo, float hi) { return lo * std::pow(hi / lo, unif(r)); }
-vec3f random_unit(pcg32& r) {
-  float z = 1 - 2 * unif(r), phi = 2 * pi_f * unif(r);
-  float s = safe_sqrt(1 - z * z);
-  return {s * std::cos(phi), s * std::sin(phi), z};
-}
-vec3f random_in(pcg32& r, vec3f lo, vec3f hi) {
-  return {lo.x + (hi.x - lo.x) * unif(r), lo.y + (hi.y - lo.y) * unif(r), lo.z + (hi.z - lo.z) * unif(r)};
-}
 
 // A set of emissive triangles (with some non-emissive ones in between) and its tree.
 struct light_set {

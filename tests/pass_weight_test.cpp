@@ -8,6 +8,7 @@
 #include "lights.h"
 #include "render.h"
 #include "scene.h"
+#include "scene_fixture.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
@@ -21,26 +22,10 @@ using namespace bl::test;
 
 namespace {
 
-struct built_scene {
-  scene_data scene;
-  bvh_data bvh;
-  light_data lights;
-};
-
 // The boxed lamp of test_util.h: the bound prior sends most NEE samples to the shut-in lamp until learning moves
 // them.
-std::unique_ptr<built_scene> boxed_lamp_scene() {
-  camera_params cam;
-  cam.automatic = false;
-  cam.eye = {2, 4, 0.01f};
-  cam.target = {2, 0, 0};
-  cam.up = {0, 0, -1};
-  cam.fov_y_deg = 40;
-  auto b = std::make_unique<built_scene>();
-  b->scene = build_scene(boxed_lamp_mesh(), cam, {}, false, 1.0f);
-  b->bvh = build_bvh(b->scene);
-  b->lights = build_lights(b->scene);
-  return b;
+std::unique_ptr<test_scene> boxed_lamp_scene() {
+  return build_test_scene(boxed_lamp_mesh(), fixed_camera({2, 4, 0.01f}, {2, 0, 0}, 40, {0, 0, -1}));
 }
 
 render_params small_params(sampler_kind kind, int spp, double weighting, uint64_t seed = 7) {

@@ -11,6 +11,7 @@
 #include "lights.h"
 #include "render.h"
 #include "scene.h"
+#include "scene_fixture.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
@@ -28,28 +29,8 @@ constexpr int image_size = 16;
 const sampler_kind all_kinds[] = {sampler_kind::uniform, sampler_kind::power, sampler_kind::bvh, sampler_kind::bound,
                                   sampler_kind::donikian, sampler_kind::bayes};
 
-struct built_scene {
-  scene_data scene;
-  bvh_data bvh;
-  light_data lights;
-};
-std::unique_ptr<built_scene> build(mesh_data mesh, const camera_params& cam, const sun_params& sun = {}) {
-  auto b = std::make_unique<built_scene>();
-  b->scene = build_scene(std::move(mesh), cam, sun, false, 1.0f);
-  b->bvh = build_bvh(b->scene);
-  b->lights = build_lights(b->scene);
-  return b;
-}
-
-camera_params looking_down(vec3f eye, vec3f target, float fov) {
-  camera_params c;
-  c.automatic = false;
-  c.eye = eye;
-  c.target = target;
-  c.up = {0, 0, -1};
-  c.fov_y_deg = fov;
-  return c;
-}
+// A camera looking down at `target` (image up is -z).
+camera_params looking_down(vec3f eye, vec3f target, float fov) { return fixed_camera(eye, target, fov, {0, 0, -1}); }
 
 // Per-pixel luminance of a render's film: the estimator's own mean, in double (film_image writes it rounded to float).
 std::vector<double> pixel_luminance(const render_result& r) {
@@ -74,7 +55,7 @@ struct row_sink {
 // Runs `passes` 1-spp passes of a Bayesian sampler built here (so its state can be inspected) and checks that its
 // statistics and coefficients stay finite, that every pair that can reach its region keeps a positive weight (else
 // a member of its cluster could never be chosen), and that it learned something.
-void check_bayes_state(const built_scene& b, int depth, const bayes_params& params = {},
+void check_bayes_state(const test_scene& b, int depth, const bayes_params& params = {},
                        bool overflows = false) {
   render_inputs in;
   in.scene = &b.scene;
@@ -83,11 +64,10 @@ void check_bayes_state(const built_scene& b, int depth, const bayes_params& para
   in.camera = make_camera(b.scene.camera, image_size, image_size);
   in.max_depth = depth;
   in.seed = 3;
-  light_tree_data tree = build_light_tree(b.lights, b.scene);
   sampler_params sp;
   sp.kind = sampler_kind::bayes;
   sp.bayes = params;
-  light_sampler ls = make_light_sampler(sp, in, tree);
+  light_sampler ls = make_light_sampler(sp, in, b.tree);
   bayes_sampler& s = std::get<bayes_sampler>(ls);
   path_stats st;
   std::vector<bayes_row> rows(static_cast<size_t>(image_size));
@@ -139,7 +119,7 @@ void check_bayes_state(const built_scene& b, int depth, const bayes_params& para
 }
 
 // Renders the scene with every sampler and checks finiteness and agreement with the uniform sampler.
-void check_scene(const built_scene& b, int depth, int spp) {
+void check_scene(const test_scene& b, int depth, int spp) {
   render_params p;
   p.width = p.height = image_size;
   p.spp = spp;
@@ -209,12 +189,12 @@ TEST_CASE("a lamp 1 mm above a floor renders consistently with every sampler", "
   m.add_quad({-0.1f, 0.001f, -0.1f}, {0.1f, 0.001f, -0.1f}, {0.1f, 0.001f, 0.1f}, {-0.1f, 0.001f, 0.1f}, lamp);
   m.add_quad({-1, 2, -1}, {1, 2, -1}, {1, 2, 1}, {-1, 2, 1}, top);
   mesh_data mesh = m.mesh;
-  auto b = build(std::move(m.mesh), looking_down({0.05f, 1.5f, 0.02f}, {0, 0, 0}, 30));
+  auto b = build_test_scene(std::move(m.mesh), looking_down({0.05f, 1.5f, 0.02f}, {0, 0, 0}, 30));
   // Direct illumination on the lamp's back alone (every first hit 1 mm above the floor): the floor by the lamp's rim
   // gets light from the 1 mm gap at distances near zero, whose NEE is so heavy-tailed for samplers that pick the lamp
   // rarely there (power: 1 %) that no sample count makes the comparison decisive (power at 1024 spp: standard error
   // 1.5 % of the image mean, one pixel drawing most of it). Path traced, the wide view reaches the rim by bounces.
-  auto back = build(std::move(mesh), looking_down({0.02f, 1.5f, 0.01f}, {0, 0, 0}, 6));
+  auto back = build_test_scene(std::move(mesh), looking_down({0.02f, 1.5f, 0.01f}, {0, 0, 0}, 6));
   check_scene(*back, 1, 256);
   check_scene(*b, 3, 128);
   check_bayes_state(*b, 3);
@@ -231,7 +211,7 @@ TEST_CASE("a lamp facing a ceiling 1 mm away renders consistently with every sam
   m.add_quad({-3, 2, -3}, {3, 2, -3}, {3, 2, 3}, {-3, 2, 3}, white);  // the ceiling
   m.add_quad({-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, white);  // the floor
   m.add_quad({-0.2f, 1.999f, -0.2f}, {-0.2f, 1.999f, 0.2f}, {0.2f, 1.999f, 0.2f}, {0.2f, 1.999f, -0.2f}, lamp);
-  auto b = build(std::move(m.mesh), looking_down({1, 1.2f, 0.01f}, {1, 2, 0}, 40));
+  auto b = build_test_scene(std::move(m.mesh), looking_down({1, 1.2f, 0.01f}, {1, 2, 0}, 40));
   check_scene(*b, 1, 512);
 }
 
@@ -243,7 +223,7 @@ TEST_CASE("two lamps with a radiance ratio of 1e6 render consistently with every
   m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
   m.add_quad({-0.05f, 3, -0.05f}, {0.05f, 3, -0.05f}, {0.05f, 3, 0.05f}, {-0.05f, 3, 0.05f}, bright);
   m.add_quad({0.5f, 0.5f, -0.5f}, {1.5f, 0.5f, -0.5f}, {1.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f}, dim);
-  auto b = build(std::move(m.mesh), looking_down({0, 4, 0.01f}, {0, 0, 0}, 60));
+  auto b = build_test_scene(std::move(m.mesh), looking_down({0, 4, 0.01f}, {0, 0, 0}, 60));
   check_scene(*b, 1, 256);
   check_scene(*b, 3, 128);
   check_bayes_state(*b, 3);
@@ -252,7 +232,7 @@ TEST_CASE("two lamps with a radiance ratio of 1e6 render consistently with every
 TEST_CASE("a bright lamp shut in a closed box next to a dim lamp renders consistently with every sampler",
           "[stiff]") {
   // The camera sees the floor beside the box (and the box's outer wall), lit by the dim lamp only.
-  auto b = build(boxed_lamp_mesh(), looking_down({2, 4, 0.01f}, {2, 0, 0}, 40));
+  auto b = build_test_scene(boxed_lamp_mesh(), looking_down({2, 4, 0.01f}, {2, 0, 0}, 40));
   check_scene(*b, 1, 2048);
   check_scene(*b, 3, 1024);
   check_bayes_state(*b, 3);
@@ -267,7 +247,7 @@ TEST_CASE("a sliver emitter of area 1e-10 renders consistently with every sample
   // Base 1 along x, height 2e-10 along z, at y = 1, facing down: area 1e-10, intensity 0.1.
   m.add_triangle({-0.5f, 1, 0}, {0.5f, 1, 0}, {0, 1, 2e-10f}, sliver);
   m.add_quad({1, 2, -0.5f}, {2, 2, -0.5f}, {2, 2, 0.5f}, {1, 2, 0.5f}, lamp);
-  auto b = build(std::move(m.mesh), looking_down({0.5f, 3, 0.01f}, {0.5f, 0, 0}, 60));
+  auto b = build_test_scene(std::move(m.mesh), looking_down({0.5f, 3, 0.01f}, {0.5f, 0, 0}, 60));
   REQUIRE(b->lights.tri_count == 3);
   CHECK(b->scene.tri_area[size_t(b->lights.tri[0])] == Approx(1e-10).epsilon(1e-3));
   CHECK(b->scene.tri_ng[size_t(b->lights.tri[0])].y == Approx(-1.0f));
@@ -291,7 +271,7 @@ TEST_CASE("NEE samples that overflow to infinity leave the Bayesian statistics f
   m.add_quad({0, 0, 0}, {0, 0, 1e-5f}, {1e-5f, 0, 1e-5f}, {1e-5f, 0, 0}, floor);
   m.add_quad({4e-6f, 1e-7f, 4e-6f}, {6e-6f, 1e-7f, 4e-6f}, {6e-6f, 1e-7f, 6e-6f}, {4e-6f, 1e-7f, 6e-6f}, lamp);
   // Looking past the lamp's edge, 7 degrees down, at the floor just under it, whose mirror direction meets the lamp.
-  auto b = build(std::move(m.mesh), looking_down({1e-6f, 4e-7f, 5e-6f}, {4.2e-6f, 0, 5e-6f}, 10));
+  auto b = build_test_scene(std::move(m.mesh), looking_down({1e-6f, 4e-7f, 5e-6f}, {4.2e-6f, 0, 5e-6f}, 10));
   check_bayes_state(*b, 1, {}, true);
   check_bayes_state(*b, 3, {}, true);
 }
@@ -314,7 +294,7 @@ TEST_CASE("a grazing continuation ray hits neither the triangle it leaves nor a 
     mb.add_triangle(a, b1, b2, grey);
     mb.add_triangle(b1, b1 + b2 - a, b2, grey);
     camera_params cam;
-    auto b = build(std::move(mb.mesh), cam);
+    auto b = build_test_scene(std::move(mb.mesh), cam);
     render_inputs in;
     in.scene = &b->scene;
     in.bvh = &b->bvh;
@@ -364,7 +344,7 @@ void add_down_disk(mesh_builder& m, vec3f c, float radius, int material) {
 // Two disk lamps of 16 fan triangles each (32 lights: cuts are clustered, so bayes refines each disk into members,
 // learned apart), each half hidden by a black blocker just below it: the floor sees some triangles of a disk and not
 // others, in penumbrae a metre wide, the case members are for. Radiances are scaled by `scale`.
-std::unique_ptr<built_scene> blocked_disks(float scale) {
+std::unique_ptr<test_scene> blocked_disks(float scale) {
   mesh_builder m;
   int floor = m.add_material({0.5f, 0.5f, 0.5f});
   int black = m.add_material({0, 0, 0});
@@ -375,7 +355,7 @@ std::unique_ptr<built_scene> blocked_disks(float scale) {
     add_down_disk(m, {x, 1.5f, 0}, 0.15f, lamps[x > 0]);
     m.add_box({x - 0.3f, 1.38f, -0.3f}, {x, 1.4f, 0.3f}, black);
   }
-  auto b = build(std::move(m.mesh), looking_down({0, 4, 0.01f}, {0, 0, 0}, 70));
+  auto b = build_test_scene(std::move(m.mesh), looking_down({0, 4, 0.01f}, {0, 0, 0}, 70));
   REQUIRE(b->lights.tri_count == 32);
   return b;
 }
@@ -417,7 +397,7 @@ TEST_CASE("a glossy floor mirroring disk lamps renders consistently with every s
     for (float x : {-0.8f, 0.8f}) add_down_disk(m, {x, 1.0f, 0}, 0.3f, lamps[x > 0]);
     camera_params cam = looking_down({0, 0.6f, 2.5f}, {0, 0, -1.2f}, 60);
     cam.up = {0, 1, 0};
-    auto b = build(std::move(m.mesh), cam);
+    auto b = build_test_scene(std::move(m.mesh), cam);
     REQUIRE(b->lights.tri_count == 32);
     if (mirror) {
       // A mirror's highlights are too noisy for the agreement test at this size; every sample must stay finite
