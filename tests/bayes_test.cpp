@@ -42,6 +42,25 @@ double normal(pcg32& r) {
   return std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
 }
 
+// Counts of zero and non-zero samples y, and the sums of z = y d^2 and z^2 over the non-zero ones (long double).
+struct sums {
+  long double n0 = 0, n1 = 0, s1 = 0, s2 = 0;
+};
+sums raw_sums(const std::vector<double>& y, long double d2) {
+  sums r;
+  for (double v : y) {
+    if (v == 0) {
+      r.n0 += 1;
+      continue;
+    }
+    long double z = v * d2;
+    r.n1 += 1;
+    r.s1 += z;
+    r.s2 += z * z;
+  }
+  return r;
+}
+
 // The conjugate posterior written out from METHOD.md section 4 with raw sums (long double), independent of
 // bayes_stats.cpp: returns sqrt((1 - p0)(k^2 + h)) / d^2 with point estimates k = mu_n, h = beta_n / (alpha_n - 1),
 // 1 - p0 the posterior mean of the non-zero probability; or the mean-only ablation (1 - p0) mu_n / d^2.
@@ -49,17 +68,7 @@ long double hand_posterior(const bayes_params& p, double bound, double scale, do
                            bool second_moment = true) {
   long double d2 = (long double)d * d;
   long double mu0 = (long double)scale * bound * d2;
-  long double n0 = 0, n1 = 0, s1 = 0, s2 = 0;
-  for (double v : y) {
-    if (v == 0) {
-      n0 += 1;
-      continue;
-    }
-    long double z = v * d2;
-    n1 += 1;
-    s1 += z;
-    s2 += z * z;
-  }
+  auto [n0, n1, s1, s2] = raw_sums(y, d2);
   long double one_minus_p0 = (p.b0 + n1) / (p.a0 + p.b0 + n0 + n1);  // Beta(a0 + n0, b0 + n1): mean of 1 - p0
   long double kn = p.kappa0 + n1;
   long double mun = (p.kappa0 * mu0 + s1) / kn;
@@ -75,17 +84,7 @@ long double hand_posterior(const bayes_params& p, double bound, double scale, do
 // the bound itself.
 long double hand_naive(double bound, double scale, double d, const std::vector<double>& y, bool second_moment) {
   long double d2 = (long double)d * d;
-  long double n0 = 0, n1 = 0, s1 = 0, s2 = 0;
-  for (double v : y) {
-    if (v == 0) {
-      n0 += 1;
-      continue;
-    }
-    long double z = v * d2;
-    n1 += 1;
-    s1 += z;
-    s2 += z * z;
-  }
+  auto [n0, n1, s1, s2] = raw_sums(y, d2);
   if (n0 + n1 == 0) return (long double)scale * bound;
   long double p1 = n1 / (n0 + n1);
   if (n1 == 0) return 0;
