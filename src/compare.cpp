@@ -101,7 +101,17 @@ double relmse_at_time(const std::vector<pass_record>& log, double t) {
   return std::exp(std::log(e0) + f * (std::log(e1) - std::log(e0)));
 }
 
+double comparison_time(const compare_data& data) {
+  double t = data.time_budget;
+  if (data.equal_time && data.signal != 0)
+    for (const compare_sampler& s : data.samplers)
+      for (const compare_run& r : s.runs)
+        if (!r.log.empty()) t = std::min(t, r.log.back().seconds);
+  return t;
+}
+
 std::vector<compare_stats> comparison_stats(const compare_data& data) {
+  const double t_cmp = comparison_time(data);
   std::vector<compare_stats> all;
   for (const compare_sampler& s : data.samplers) {
     compare_stats st;
@@ -126,10 +136,13 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
       st.curve_relmse.push_back(e / k);
     }
     st.seconds = st.curve_seconds.back();
-    // Each run's relMSE at the end: at exactly the budget at equal time (runs stop at different passes past it).
+    // Each run's relMSE at the end: at exactly the comparison time at equal time (runs stop at different passes past
+    // it), which may lie before a run's first pass when the budget is that short.
     auto end_relmse = [&](const compare_run* r) {
-      return data.equal_time ? relmse_at_time(r->log, data.time_budget) : r->log.back().error.relmse;
+      return data.equal_time ? relmse_at_time(r->log, t_cmp) : r->log.back().error.relmse;
     };
+    for (const compare_run* r : runs)
+      if (data.equal_time && r->log[0].seconds > t_cmp) st.before_first_pass = true;
     st.relmse = 0;
     for (const compare_run* r : runs) st.relmse += end_relmse(r) / k;
     st.spp_min = st.spp_max = runs[0]->spp;
@@ -147,18 +160,18 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
   if (all.empty() || all[0].runs == 0) return all;
   const compare_stats& base = all[0];
   for (compare_stats& st : all) {
-    if (st.runs == 0) {
+    if (st.runs == 0 || st.before_first_pass || base.before_first_pass) {
       st.speedup = NAN;
-      continue;
+      if (st.runs == 0) continue;
     }
     double num = data.equal_time ? base.relmse : base.relmse * base.seconds;
     double den = data.equal_time ? st.relmse : st.relmse * st.seconds;
-    st.speedup = den > 0 && std::isfinite(num) && std::isfinite(den) ? num / den : NAN;
+    if (!std::isnan(st.speedup)) st.speedup = den > 0 && std::isfinite(num) && std::isfinite(den) ? num / den : NAN;
     // The first sampler reaches its own relMSE at its end by definition: at the budget at equal time (its curve can
-    // rise again in the pass after it, heavy-tailed as relMSE is), or at its last pass when a signal stopped it
-    // sooner; at its mean time at equal spp (where its curve's last point, the mean of sums, can differ from the sum
-    // of means in the last bit and miss it).
-    if (&st == &all[0]) st.time_to_target = data.equal_time ? std::min(data.time_budget, st.seconds) : st.seconds;
+    // rise again in the pass after it, heavy-tailed as relMSE is), which is at the shortest run's last pass when a
+    // signal stopped them sooner; at its mean time at equal spp (where its curve's last point, the mean of sums, can
+    // differ from the sum of means in the last bit and miss it).
+    if (&st == &all[0]) st.time_to_target = data.equal_time ? std::min(t_cmp, st.seconds) : st.seconds;
     else st.time_to_target = time_to_reach(st.curve_seconds, st.curve_relmse, base.relmse);
   }
   return all;
@@ -190,8 +203,20 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
                             (unsigned long long)(rp.seed + uint64_t(p.runs - 1)));
   s += rp.threads > 0 ? format(" | %d threads\n\n", rp.threads) : std::string(" | threads: all cores\n\n");
   s += (p.reference_note.empty() ? "reference: " + p.reference_path : p.reference_note) + "\n\n";
-  if (data.signal != 0)
-    s += format("**Interrupted** by signal %d: the table covers the passes completed before it.\n\n", data.signal);
+  const double t_cmp = comparison_time(data);
+  if (data.signal != 0) {
+    s += format("**Interrupted** by signal %d: the table covers the passes completed before it", data.signal);
+    s += data.equal_time && t_cmp < data.time_budget
+             ? format(", and compares the samplers at %.4g s, where the shortest run ended.\n\n", t_cmp)
+             : std::string(".\n\n");
+  }
+  std::string early;
+  for (size_t i = 0; i < stats.size(); i++)
+    if (stats[i].before_first_pass) early += std::string(early.empty() ? "" : ", ") + sampler_name(data.samplers[i].kind);
+  if (!early.empty())
+    s += format("**The comparison time, %.4g s, ends before the first pass of %s**: the relMSE given is that pass's, "
+                "at a later time than the others', so there is no speed-up against it (a longer --time compares "
+                "them).\n\n", t_cmp, early.c_str());
 
   std::string target = stats.empty() || stats[0].runs == 0 ? std::string("?") : format("%.4e", stats[0].relmse);
   s += "| sampler | spp | seconds | relMSE | speed-up vs " + base +
@@ -214,13 +239,14 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
   }
 
   s += "\n- **relMSE**: mean over pixels and RGB channels of (x \xe2\x88\x92 r)\xc2\xb2 / (r\xc2\xb2 + 0.01) ";
-  s += data.equal_time ? "at exactly the time budget (log-log between the last pass before it and the first at or "
+  s += data.equal_time ? "at exactly the comparison time (log-log between the last pass before it and the first at or "
                          "after it; spp and seconds are the final pass's)"
                        : "after the final pass";
   s += p.runs > 1 ? format("; mean \xc2\xb1 standard deviation over the %d runs.\n", p.runs) : std::string(".\n");
   if (data.equal_time)
     s += "- **speed-up** at equal time: relMSE of " + base + " / relMSE of the sampler, both at the time budget "
-         "(each render stops after the first whole pass that reaches it; its error at the budget is interpolated).\n";
+         "(each render stops after the first whole pass that reaches it; its error at the budget is interpolated), "
+         "or where a signal cut the renders short, at the end of the shortest run.\n";
   else
     s += "- **speed-up** at equal spp: the efficiency ratio (relMSE \xc3\x97 seconds of " + base +
          ") / (relMSE \xc3\x97 seconds of the sampler), which is the equal-time speed-up when relMSE falls as "

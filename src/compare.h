@@ -68,6 +68,8 @@ struct compare_stats {
                                      // exactly the time budget (relmse_at_time) at equal time, else the final one
   double setup_seconds = 0;          // mean setup time (light tree, regions; not in `seconds`)
   double speedup = 0;                // against the first sampler (NaN when undefined)
+  bool before_first_pass = false;    // equal time: a run's first pass ended after the comparison time, so its relmse
+                                     // is that pass's, not the error at that time (no speed-up then)
   double time_to_target = -1;        // seconds until it stays at or below the first sampler's relmse
 };
 
@@ -79,6 +81,9 @@ double relmse_at_time(const std::vector<pass_record>& log, double t);
 // Renders every (run, sampler) one at a time; stops early on SIGINT/SIGTERM (data.signal).
 compare_data run_comparison(const scene_data& scene, const bvh_data& bvh, const light_data& lights,
                             const image_data& reference, const compare_params& params);
+// The time at which an equal-time comparison compares the samplers: the budget, or where a signal cut the renders
+// short, the end of the shortest run (every run's error exists there; the budget is 0 at equal spp).
+double comparison_time(const compare_data& data);
 // Statistics of every sampler. Speed-up: equal time: relMSE_first / relMSE; equal spp: the efficiency ratio
 // (relMSE x seconds)_first / (relMSE x seconds).
 std::vector<compare_stats> comparison_stats(const compare_data& data);

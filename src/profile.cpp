@@ -166,9 +166,10 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
          100 * lp.regions / b.seconds);
     line("  %-44s %10.1f %7.1f%%\n", "  of which: refold of changed weights", lp.refold / nee_b * 1e9,
          100 * lp.refold / b.seconds);
-    line("  %-44s %10.2f records, %.2f refolds per %s (%.1f, %.1f ns each)\n", "  learning work:",
-         lp.records / nee_b, lp.refolds / nee_b, unit, lp.reduce / std::max(lp.records, 1.0) * 1e9,
-         lp.refold / std::max(lp.refolds, 1.0) * 1e9);
+    if (lp.records + lp.refolds > 0)
+      line("  %-44s %10.2f records, %.2f refolds per %s (%.1f, %.1f ns each)\n", "  learning work:",
+           lp.records / nee_b, lp.refolds / nee_b, unit, lp.reduce / std::max(lp.records, 1.0) * 1e9,
+           lp.refold / std::max(lp.refolds, 1.0) * 1e9);
   }
   line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee_b * 1e9, 100.0);
   line("\n  raw Embree rtcOccluded1 on this scene: %.2f M rays/s (%zu rays, %d threads)\n", limit * 1e-6,
@@ -187,12 +188,14 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
     for (size_t k = 0; k < 3 && k < others.size(); k++)
       line("%s %s %.1f%%", k ? "," : "", others[k].second.c_str(), 100 * others[k].first / b.seconds);
     line("\n");
-    // Each NEE sample of a direct-only render pays one camera ray: with one NEE sample per camera hit the fraction
-    // cannot exceed t_raw / (t_raw + t_camera) even if everything else were free.
-    double t_raw = 1 / limit, t_cam = stage_wall(prof_camera) / nee_b;
-    if (params.max_depth == 1 && t_cam > 0)
-      line("  with one NEE sample per camera ray the fraction is at most %.2f (a camera ray costs %.1f raw shadow rays "
-           "here)\n", t_raw / (t_raw + t_cam), t_cam / t_raw);
+    // A direct-only render pays camera_rays / nee_samples camera rays per NEE sample (one where every camera ray
+    // hits a surface that samples a light; more where rays miss or hit emitters): even if everything else were
+    // free, the fraction cannot exceed t_raw / (t_raw + that many camera rays' time).
+    double t_raw = 1 / limit, t_cam_nee = stage_wall(prof_camera) / nee_b;
+    double per_nee = double(b.stats.camera_rays) / nee_b;
+    if (params.max_depth == 1 && t_cam_nee > 0 && !per_ray && b.stats.camera_rays > 0)
+      line("  with its camera rays the fraction is at most %.2f (%.2f camera rays per NEE sample, each costing %.2f raw "
+           "shadow rays here)\n", t_raw / (t_raw + t_cam_nee), per_nee, t_cam_nee / per_nee / t_raw);
   }
   line("  between-pass learning: %.2f%% of the plain render's time\n", 100 * a.learn_seconds / std::max(a.seconds, 1e-9));
   double extra = 100 * (b.seconds / a.seconds - 1);

@@ -997,6 +997,28 @@ TEST_CASE("a profile of a scene without NEE samples gives its stages per camera 
   CHECK(r.output.find("ns/NEE") == std::string::npos);
 }
 
+TEST_CASE("a profile counts the camera rays each NEE sample pays for", "[cli]") {
+  // The camera stage's time per NEE sample was divided by a raw shadow ray's time and reported as the cost of one
+  // camera ray; where most camera rays miss (here the Cornell box seen from 50 m) that is many camera rays' cost.
+  temp_dir dir;
+  write_text(dir / "far.json", "{\"mesh\": \"" + source_path("data/cornell/cornell.obj") +
+                                   "\", \"camera\": {\"eye\": [2.78, 2.73, 50], \"target\": [2.78, 2.73, 0], "
+                                   "\"fov_y_deg\": 39.3}, \"render\": {\"max_depth\": 1}}");
+  auto r = run_bayeslight("profile " + dir / "far.json" + " --width 32 --height 24 --spp 8 --threads 1");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const std::string key = "with its camera rays the fraction is at most ";
+  size_t at = r.output.find(key);
+  REQUIRE(at != std::string::npos);
+  std::istringstream line(r.output.substr(at + key.size()));
+  double fraction = 0, per_nee = 0;
+  char paren = 0;
+  line >> fraction >> paren >> per_nee;
+  CHECK(fraction > 0);
+  CHECK(fraction < 1);
+  CHECK(per_nee > 3);  // the box covers about a twentieth of the image
+}
+
 TEST_CASE("an interrupted profile says so and prints no report", "[cli]") {
   // It printed a table of -nan % and ran the shadow-ray benchmark before exiting 130 (a review).
   std::string cmd = "timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " profile " +

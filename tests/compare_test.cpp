@@ -528,6 +528,75 @@ TEST_CASE("an interrupted equal-time comparison times the first sampler at its l
   CHECK(comparison_stats(d)[0].time_to_target == Approx(3.0));
 }
 
+TEST_CASE("an interrupted equal-time comparison compares the samplers where the shortest run ended", "[compare]") {
+  // SIGINT during the second sampler: the first ran to the 2 s budget, the second stopped at 0.88 s. The speed-up
+  // compared the first's error at 2 s with the second's at 0.88 s (0.65 in a review, 0.99 at a common time).
+  compare_data d;
+  d.samplers.resize(2);
+  d.equal_time = true;
+  d.time_budget = 2;
+  d.signal = 2;
+  auto run_of = [](std::vector<double> times) {
+    compare_run run;
+    run.spp = int(times.size());
+    for (double t : times) {
+      pass_record p;
+      p.seconds = t;
+      p.has_error = true;
+      p.error.relmse = 0.1 / t;  // both samplers have the same error at the same time
+      run.log.push_back(p);
+    }
+    return run;
+  };
+  d.samplers[0].runs.push_back(run_of({0.25, 0.5, 1.0, 2.1}));
+  d.samplers[1].runs.push_back(run_of({0.3, 0.6, 0.88}));
+  CHECK(comparison_time(d) == 0.88);
+  std::vector<compare_stats> st = comparison_stats(d);
+  REQUIRE(st.size() == 2);
+  CHECK(st[0].relmse == Approx(0.1 / 0.88).epsilon(1e-9));
+  CHECK(st[1].speedup == Approx(1).epsilon(1e-9));
+  CHECK(st[0].time_to_target == Approx(0.88));
+  compare_params p;
+  p.samplers = {sampler_kind::uniform, sampler_kind::bayes};
+  p.render.time_budget = 2;
+  CHECK(comparison_summary(d, p).find("compares the samplers at 0.88 s") != std::string::npos);
+  d.signal = 0;  // complete: at the budget
+  CHECK(comparison_time(d) == 2);
+}
+
+TEST_CASE("an equal-time comparison shorter than a first pass gives no speed-up against that sampler", "[compare]") {
+  compare_data d;
+  d.samplers.resize(3);
+  d.equal_time = true;
+  d.time_budget = 0.001;  // passes end at 0.84 ms (first sampler, then 1.5 ms), 2.4 ms (second), 0.5 ms (third)
+  std::vector<std::vector<double>> times = {{0.00084, 0.0015}, {0.0024}, {0.0005, 0.0011}};
+  for (size_t i = 0; i < 3; i++) {
+    compare_run run;
+    run.spp = 1;
+    for (double t : times[i]) {
+      pass_record p;
+      p.seconds = t;
+      p.has_error = true;
+      p.error.relmse = 1e-4 / t;
+      run.log.push_back(p);
+    }
+    d.samplers[i].runs.push_back(run);
+  }
+  d.samplers[0].kind = sampler_kind::uniform;
+  d.samplers[1].kind = sampler_kind::power;
+  d.samplers[2].kind = sampler_kind::bound;
+  std::vector<compare_stats> st = comparison_stats(d);
+  REQUIRE(st.size() == 3);
+  CHECK(!st[0].before_first_pass);
+  CHECK(st[1].before_first_pass);
+  CHECK(std::isnan(st[1].speedup));
+  CHECK(st[2].speedup == Approx(1).epsilon(1e-9));
+  compare_params p;
+  p.samplers = {sampler_kind::uniform, sampler_kind::power, sampler_kind::bound};
+  p.render.time_budget = 0.001;
+  CHECK(comparison_summary(d, p).find("ends before the first pass of power") != std::string::npos);
+}
+
 TEST_CASE("the plot writer escapes labels and draws one path per series", "[compare]") {
   plot_series a{"a<b>&\"c\"", {0.01, 0.1, 1}, {1, 0.1, 0.01}};
   plot_series b{"second", {0.0, -1, 0.5, 2}, {1, 1, 0.2, NAN}};  // only (0.5, 0.2) can be placed on log axes
