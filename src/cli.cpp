@@ -581,7 +581,9 @@ void add_render_command(CLI::App& app, render_options& o) {
                 "SCENE's name with .exr, in the current directory)")
       ->allow_extra_args(false)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  r->add_option("--reference", o.reference, "Reference .exr/.pfm of the same size: error after every pass")
+  r->add_option("--reference", o.reference,
+                "Reference .exr/.pfm of the same size: error after every pass (in --log), the final one in the "
+                "summary line")
       ->check(file_name);
   r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse")->check(file_name);
   r->add_option("--frames", o.frames,

@@ -38,6 +38,10 @@ std::string render_summary(const render_result& r, const std::vector<std::string
                 r.seconds > 0 ? rays / r.seconds * 1e-6 : 0.0,
                 r.seconds > 0 ? double(st.nee_samples) / r.seconds * 1e-6 : 0.0);
   std::string s = buf;
+  if (!r.log.empty() && r.log.back().has_error) {  // --reference: the error of the image written
+    std::snprintf(buf, sizeof buf, "; relMSE %.4e against the reference", r.log.back().error.relmse);
+    s += buf;
+  }
   if (st.nee_samples > 0) {
     std::snprintf(buf, sizeof buf, "; %.1f%% of NEE samples contribute nothing", 100.0 * double(st.nee_zero) / double(st.nee_samples));
     s += buf;

@@ -137,6 +137,26 @@ TEST_CASE("the log carries error against a reference and diff reports it", "[cli
   CHECK(same.output.find("identical") != std::string::npos);
 }
 
+TEST_CASE("a render with a reference and no log reports the error of its image", "[cli]") {
+  // --reference without --log read and checked the reference, and reported nothing it measured.
+  tiny_scene s;
+  REQUIRE(run_bayeslight("render " + s.json + " --sampler uniform --spp 16 -o " + (s.dir / "ref.exr") + " --quiet")
+              .status == 0);
+  auto r = run_bayeslight("render " + s.json + " --sampler power --spp 3 -o " + (s.dir / "x.exr") + " --reference " +
+                          (s.dir / "ref.exr"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const std::string key = "; relMSE ";
+  size_t at = r.output.find(key);
+  REQUIRE(at != std::string::npos);
+  CHECK(r.output.find(" against the reference", at) != std::string::npos);
+  auto d = run_bayeslight("diff " + (s.dir / "x.exr") + " " + (s.dir / "ref.exr"));
+  REQUIRE(d.status == 0);
+  double diff_relmse = std::stod(d.output.substr(7, d.output.find(' ') - 7));
+  CHECK(diff_relmse > 0);
+  CHECK(std::stod(r.output.substr(at + key.size())) == Approx(diff_relmse).epsilon(1e-4));  // printed to 5 digits
+}
+
 TEST_CASE("options may come before the scene: -o and --samplers take one value each", "[cli]") {
   tiny_scene s;
   auto r = run_bayeslight("render -o " + (s.dir / "a.pfm") + " -o " + (s.dir / "a.png") + " --spp 1 " + s.json +
