@@ -228,7 +228,8 @@ static exr_precheck exr_header_precheck(const unsigned char* mem, size_t size) {
   return out;
 }
 
-// Reads R, G, B of a single-part scanline EXR (without them Y, or a file's only channel, is replicated to grey);
+// Reads R, G, B of a single-part scanline EXR (without them Y, or a file's only channel, is replicated to grey;
+// luminance/chroma and XYZ files are refused);
 // alpha and other channels are ignored. Tiled files are rejected: tinyexr's tiled error paths free memory unreliably.
 static image_data read_exr(const std::string& path) {
   std::string bytes = read_file(path);
@@ -256,6 +257,8 @@ static image_data read_exr(const std::string& path) {
   if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
     if (find_channel(h, "RY") >= 0 || find_channel(h, "BY") >= 0)
       throw input_error(path, "luminance/chroma OpenEXR files (Y, RY, BY) are not supported (write R, G, B)");
+    if (find_channel(h, "X") >= 0 && find_channel(h, "Z") >= 0)
+      throw input_error(path, "CIE XYZ OpenEXR files (X, Y, Z) are not supported (write R, G, B)");
     const int y = find_channel(h, "Y");  // luminance (with alpha or others): grey
     if (y >= 0) {
       rgb[0] = rgb[1] = rgb[2] = y;

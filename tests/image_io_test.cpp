@@ -242,6 +242,9 @@ TEST_CASE("EXR files in any line order, and grey ones with alpha, read as writte
   // Luminance/chroma (Y with RY and BY): not grey, refused.
   write_file_atomic(dir / "yc.exr", handmade_exr(w, h, {"BY", "RY", "Y"}, {alpha, alpha, lum}, 0));
   CHECK_THAT(read_error(dir / "yc.exr"), Catch::Contains("luminance/chroma"));
+  // CIE XYZ: Y alone would be read as a grey image without a word (a review); refused.
+  write_file_atomic(dir / "xyz.exr", handmade_exr(w, h, {"X", "Y", "Z"}, {alpha, lum, alpha}, 0));
+  CHECK_THAT(read_error(dir / "xyz.exr"), Catch::Contains("CIE XYZ"));
   // Two channels, neither R, G, B nor Y: refused, naming what the file has.
   write_file_atomic(dir / "uv.exr", handmade_exr(w, h, {"U", "V"}, {alpha, lum}, 0));
   CHECK_THAT(read_error(dir / "uv.exr"), Catch::Contains("found: U, V"));
