@@ -110,8 +110,32 @@ void check_output_path(const std::string& path) {
     fs::path target = fs::path(output_target(path)).parent_path();  // where it points
     if (!target.empty()) dir = target;
   }
-  if (!fs::is_directory(dir, ec)) throw output_error("cannot write " + path + ": directory " + dir.string() + " does not exist");
+  if (!fs::is_directory(dir, ec))
+    throw output_error("cannot write " + path + ": " +
+                       (fs::exists(dir, ec) ? dir.string() + " is not a directory"
+                                            : "directory " + dir.string() + " does not exist"));
   if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write " + path + ": directory " + dir.string() + " is not writable");
+}
+
+// Options that only some samplers (or some other option) use: given where they cannot apply, they are named in a
+// warning (they change nothing, and a user comparing ablations should know). What each applies to: the groups of
+// region and Bayesian options, and a few by name.
+const char* const region_group = "Regions and light cuts (bound, donikian, bayes)";
+const char* const bayes_group = "Bayesian sampler (bayes): prior strengths and ablations";
+
+// What option `name` (of group `group`) applies to, when a render with sampler `kind` and options o does not use
+// it; empty when it does.
+std::string unused_because(const std::string& name, const std::string& group, sampler_kind kind,
+                           const render_options& o) {
+  const bool bayes = kind == sampler_kind::bayes, bound = kind == sampler_kind::bound;
+  const bool adaptive = bayes || kind == sampler_kind::donikian;
+  if (name == "--cut-members" || group == bayes_group) return bayes ? "" : "bayes only";
+  // (donikian's deeper vertices use bound's regions, and its first-hit cut their --max-cut)
+  if (group == region_group) return bound || adaptive ? "" : "bound, donikian and bayes only";
+  if (name == "--pass-weighting") return adaptive ? "" : "bayes and donikian only";
+  if (name == "--frame-decay") return o.frames > 1 && adaptive ? "" : "with --frames and bayes or donikian only";
+  if (name == "--checkpoint-every") return o.checkpoint.empty() ? "with --checkpoint only" : "";
+  return "";
 }
 
 // The validated render parameters of a scene and the command line.
@@ -141,6 +165,13 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.pass_weighting = o.pass_weighting;
   p.stratify = !o.independent;
   p.progress = p.notes = !o.quiet && stderr_is_terminal();
+  // Fine regions at depths the paths never reach change nothing either (warn_unused_options runs before the scene,
+  // which may give the max depth, is read).
+  bool fine_depth_given = false;
+  for (const auto& given : o.given) fine_depth_given |= given.first == "--fine-depth";
+  if (fine_depth_given && o.regions.fine_depth > p.max_depth && unused_because("--fine-depth", region_group, kind, o).empty())
+    std::fprintf(stderr, "bayeslight: warning: --fine-depth %d is above the max depth %d: depths past %d change nothing\n",
+                 o.regions.fine_depth, p.max_depth, p.max_depth);
   return p;
 }
 
@@ -179,27 +210,6 @@ static std::string escape_percent(const std::string& s) {
 // Reads a reference image of the render's size.
 image_data load_reference(const std::string& path, const render_params& params) {
   return read_reference(path, params.width, params.height);
-}
-
-// Options that only some samplers (or some other option) use: given where they cannot apply, they are named in a
-// warning (they change nothing, and a user comparing ablations should know). What each applies to: the groups of
-// region and Bayesian options, and a few by name.
-const char* const region_group = "Regions and light cuts (bound, donikian, bayes)";
-const char* const bayes_group = "Bayesian sampler (bayes): prior strengths and ablations";
-
-// What option `name` (of group `group`) applies to, when a render with sampler `kind` and options o does not use
-// it; empty when it does.
-std::string unused_because(const std::string& name, const std::string& group, sampler_kind kind,
-                           const render_options& o) {
-  const bool bayes = kind == sampler_kind::bayes, bound = kind == sampler_kind::bound;
-  const bool adaptive = bayes || kind == sampler_kind::donikian;
-  if (name == "--cut-members" || group == bayes_group) return bayes ? "" : "bayes only";
-  // (donikian's deeper vertices use bound's regions, and its first-hit cut their --max-cut)
-  if (group == region_group) return bound || adaptive ? "" : "bound, donikian and bayes only";
-  if (name == "--pass-weighting") return adaptive ? "" : "bayes and donikian only";
-  if (name == "--frame-decay") return o.frames > 1 && adaptive ? "" : "with --frames and bayes or donikian only";
-  if (name == "--checkpoint-every") return o.checkpoint.empty() ? "with --checkpoint only" : "";
-  return "";
 }
 
 // Warns about the options given that no render of `kinds` uses, each with what it applies to.
@@ -383,7 +393,8 @@ int run_render(const render_options& o) {
     if (!o.log.empty() && result.passes > 0)
       failures.attempt(
           [&] { write_file_atomic(frame_path(o.log, frame, animated), pass_log_csv(o.sampler, result.log)); });
-    if (!o.quiet || result.interrupted) {
+    // (--quiet too when a signal came, during the render or while the outputs were written: say what was written)
+    if (!o.quiet || result.interrupted || interrupt_signal() != 0) {
       std::string prefix = params.frames > 1 ? "frame " + std::to_string(frame) + ": " : "";
       std::fprintf(stderr, "%s%s\n", prefix.c_str(), render_summary(result, files).c_str());
     }
@@ -441,6 +452,30 @@ const CLI::Validator decimal_integer(
         return "Value " + text + " is not a decimal integer";
       size_t first = text.find_first_not_of('0', digits);
       text.erase(digits, (first == std::string::npos ? text.size() - 1 : first) - digits);
+      return {};
+    },
+    "");
+
+// Decimal numbers likewise: strtod also reads "0x10" (16), "+0.5", " 2" and "inf", and a value that is not a number at
+// all ("1e", "0.5s") was reported as out of range. A plain decimal with an optional '-', fraction and exponent.
+const CLI::Validator decimal_number(
+    [](std::string& text) -> std::string {
+      auto digits = [&](size_t i) {
+        size_t j = i;
+        while (j < text.size() && text[j] >= '0' && text[j] <= '9') j++;
+        return j;
+      };
+      size_t i = text.size() > 1 && text[0] == '-' ? 1 : 0;
+      size_t int_end = digits(i), end = int_end;
+      if (end < text.size() && text[end] == '.') end = digits(end + 1);
+      bool mantissa = int_end > i || end > int_end + 1;  // digits before or after the point
+      if (mantissa && end < text.size() && (text[end] == 'e' || text[end] == 'E')) {
+        size_t e = end + 1;
+        if (e < text.size() && (text[e] == '-' || text[e] == '+')) e++;
+        size_t e_end = digits(e);
+        end = e_end > e ? e_end : std::string::npos;  // an exponent needs digits
+      }
+      if (!mantissa || end != text.size()) return "Value " + text + " is not a decimal number";
       return {};
     },
     "");
@@ -656,7 +691,7 @@ void add_compare_command(CLI::App& app, compare_options& o) {
   // (One string, split here: a vector option would show as "TEXT ..." in the help, as if it took several words.)
   c->add_option("--samplers", o.samplers, "Comma-separated samplers, the first is the baseline: " + sampler_names())
       ->required()->type_name("NAME,NAME,...");
-  c->add_option("--out", o.out, "Output directory (created if missing)")->required();
+  c->add_option("--out", o.out, "Output directory (created if missing)")->required()->check(file_name);
   c->add_option("--runs", o.runs, "Runs per sampler, seeds base, base+1, ... (default 1)")->check(CLI::Range(1, 10000));
   c->add_option("--reference-note", o.reference_note, "How the reference was made, for summary.md");
   add_render_options(c, o.render);
@@ -703,6 +738,17 @@ int run_compare_command(const compare_options& o) {
 
 }  // namespace
 
+// Prints the help CLI11 was asked for (to std::cout); help that could not be written (a full disk) is a failure.
+static int help_exit(CLI::App& app, const CLI::Error& e) {
+  int status = app.exit(e);
+  std::cout.flush();
+  if (!std::cout) {
+    std::fprintf(stderr, "bayeslight: error: cannot write standard output\n");
+    return exit_failure;
+  }
+  return status;
+}
+
 int run_cli(int argc, char** argv) {
   // A reader that goes away (a pipe into head, a FIFO output's reader) makes writes fail with EPIPE, reported as
   // write failures (stdout, outputs), instead of killing the process between outputs; stderr's messages are lost.
@@ -739,6 +785,7 @@ int run_cli(int argc, char** argv) {
   for (CLI::App* command : app.get_subcommands({}))
     for (CLI::Option* opt : command->get_options())
       if (opt->get_type_name().rfind("INT", 0) == 0) opt->transform(decimal_integer);
+      else if (opt->get_type_name().rfind("FLOAT", 0) == 0) opt->transform(decimal_number);
   try {
     app.parse(argc, argv);
     // The options given, with their help groups (what they apply to), for warn_unused_options.
@@ -748,9 +795,9 @@ int run_cli(int argc, char** argv) {
           if (opt->count() > 0 && !opt->get_lnames().empty())
             opts->given.emplace_back("--" + opt->get_lnames()[0], opt->get_group());
   } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
+    return help_exit(app, e);
   } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
+    return help_exit(app, e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return exit_usage;

@@ -308,15 +308,17 @@ void write_comparison(const compare_data& data, const compare_params& p, const i
 }
 
 // Creates the output directory when missing, with any missing parents (as mkdir -p); throws output_error when it
-// cannot be used.
-static void make_output_dir(const std::string& dir) {
+// cannot be used. Returns whether it created it.
+static bool make_output_dir(const std::string& dir) {
   std::error_code ec;
+  bool created = false;
   if (!fs::exists(dir, ec)) {
-    if (!fs::create_directories(dir, ec) && !fs::is_directory(dir))
-      throw output_error("cannot create directory " + dir + ": " + ec.message());
+    created = fs::create_directories(dir, ec);
+    if (!created && !fs::is_directory(dir)) throw output_error("cannot create directory " + dir + ": " + ec.message());
   }
   if (!fs::is_directory(dir, ec)) throw output_error("cannot write into " + dir + ": not a directory");
   if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write into " + dir + ": directory is not writable");
+  return created;
 }
 
 int run_compare(const scene_desc& desc, const compare_params& params) {
@@ -346,17 +348,22 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   loading.reset();
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", params.scene_path.c_str());
-  make_output_dir(params.out_dir);
-
-  if (int status = interrupted_before_render()) return status;
+  const bool created = make_output_dir(params.out_dir);
+  // Interrupted with nothing to report (as render, which then keeps the files already there): a folder this run
+  // created is removed again, since it stays empty.
+  auto nothing_written = [&](int status) {
+    std::error_code ec;
+    if (created) fs::remove(params.out_dir, ec);  // (only if still empty)
+    return status;
+  };
+  if (int status = interrupted_before_render()) return nothing_written(status);
   compare_data data = run_comparison(scene, bvh, lights, reference, params);
   bool any_pass = false;
   for (const compare_sampler& s : data.samplers)
     for (const compare_run& r : s.runs) any_pass = any_pass || !r.log.empty();
   if (!any_pass && data.signal != 0) {
-    // Nothing to report (as render, which then keeps the files already there).
     std::fprintf(stderr, "compare: interrupted before the first pass; nothing written\n");
-    return 128 + data.signal;
+    return nothing_written(128 + data.signal);
   }
   write_comparison(data, params, reference);
   // (A signal that came after the last render, while the files were written, ends the command as interrupted.)

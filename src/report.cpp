@@ -33,10 +33,14 @@ std::string render_summary(const render_result& r, const std::vector<std::string
   const path_stats& st = r.stats;
   double rays = double(st.camera_rays + st.shadow_rays + st.bounce_rays);
   char buf[512];
-  std::snprintf(buf, sizeof buf, "%s %d spp in %.2f s (%d pass%s, %.2f Mrays/s, %.2f M NEE samples/s)",
-                r.interrupted ? "interrupted after" : "rendered", r.spp, r.seconds, r.passes, r.passes == 1 ? "" : "es",
-                r.seconds > 0 ? rays / r.seconds * 1e-6 : 0.0,
-                r.seconds > 0 ? double(st.nee_samples) / r.seconds * 1e-6 : 0.0);
+  // (The time is the completed passes': "after 0 spp in 0.00 s" read as if the render had not started.)
+  if (r.interrupted && r.spp == 0)
+    std::snprintf(buf, sizeof buf, "interrupted during the first pass");
+  else
+    std::snprintf(buf, sizeof buf, "%s %d spp in %.2f s (%d pass%s, %.2f Mrays/s, %.2f M NEE samples/s)",
+                  r.interrupted ? "interrupted after" : "rendered", r.spp, r.seconds, r.passes,
+                  r.passes == 1 ? "" : "es", r.seconds > 0 ? rays / r.seconds * 1e-6 : 0.0,
+                  r.seconds > 0 ? double(st.nee_samples) / r.seconds * 1e-6 : 0.0);
   std::string s = buf;
   if (!r.log.empty() && r.log.back().has_error) {  // --reference: the error of the image written
     std::snprintf(buf, sizeof buf, "; relMSE %.4e against the reference", r.log.back().error.relmse);

@@ -191,6 +191,16 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
       {"render " + s.json + " --spp +5", "--spp: Value +5 is not a decimal integer"},
       {"render " + s.json + " --width 1.5", "--width: Value 1.5 is not a decimal integer"},
       {"render " + s.json + " --grid 0b11", "--grid: Value 0b11 is not a decimal integer"},
+      // Real numbers too: --time 0x10 rendered for 16 s, and "1e" or "0.5s" were called out of range.
+      {"render " + s.json + " --time 0x10", "--time: Value 0x10 is not a decimal number"},
+      {"render " + s.json + " --time +0.5", "--time: Value +0.5 is not a decimal number"},
+      {"render " + s.json + " --time \" 2\"", "--time: Value  2 is not a decimal number"},
+      {"render " + s.json + " --time 1e", "--time: Value 1e is not a decimal number"},
+      {"render " + s.json + " --time 0.5s", "--time: Value 0.5s is not a decimal number"},
+      {"render " + s.json + " --pass-weighting 1,5", "--pass-weighting: Value 1,5 is not a decimal number"},
+      {"render " + s.json + " --time .", "--time: Value . is not a decimal number"},
+      {"compare " + s.json + " --spp 1 --reference " + (s.dir / "r.pfm") + " --samplers uniform --out \"\"",
+       "--out: an empty file name"},
       {"render " + s.json + " --spp 4 --time 1", "--time"},
       {"render " + s.json + " --threads 0", "--threads"},
       {"render " + s.json + " --max-depth 0", "--max-depth"},
@@ -641,6 +651,22 @@ TEST_CASE("a FIFO output whose reader closes early or stops reading is a reporte
   CHECK(seconds < 15);
 }
 
+TEST_CASE("a quiet render interrupted while writing its outputs says what it wrote", "[cli]") {
+  // The render was complete and a FIFO output waited for a reader when SIGINT came: it exited 130 naming only the
+  // FIFO's failure, not the images it did write (README: with --quiet an interrupted render still says what it wrote).
+  tiny_scene s;
+  const std::string fifo = s.dir / "out.pfm";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  int status = shell_status(std::string("( timeout -k 10 20 ") + BAYESLIGHT_BINARY + " render " + s.json +
+                            " --quiet --spp 2 -o " + (s.dir / "a.pfm") + " -o " + fifo + " -o " + (s.dir / "b.png") +
+                            " 2>" + (s.dir / "err.txt") + " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo $? )");
+  std::string err = read_text(s.dir / "err.txt");
+  INFO(err);
+  CHECK(status == 130);
+  CHECK(err.find("rendered 2 spp") != std::string::npos);
+  CHECK(err.find("-> " + (s.dir / "a.pfm") + ", " + (s.dir / "b.png")) != std::string::npos);
+}
+
 TEST_CASE("one SIGINT ends every FIFO wait, and the outputs after a failed one are still written", "[cli]") {
   // A checkpoint FIFO without a reader: SIGINT ended its wait, but the final checkpoint waited again (a second SIGINT
   // was needed); and the FIFO image's failure lost the outputs after it (keep.pfm, the log) though the run exited 130.
@@ -792,6 +818,48 @@ TEST_CASE("options that change nothing in a run are named in a warning", "[cli]"
     CHECK(r.status == 0);
     CHECK((r.output.find("ignored: --bayes-c (bayes only)") != std::string::npos) == (std::string(samplers) == "uniform,power"));
   }
+}
+
+TEST_CASE("real-valued options take plain decimals with a fraction and exponent", "[cli]") {
+  tiny_scene s;
+  for (const char* v : {"0.5", ".5", "5.", "5e-1", "0.05E+1", "-0"}) {
+    auto r = run_bayeslight("render " + s.json + " --quiet --spp 2 --pass-weighting " + v + " -o " + (s.dir / "a.pfm"));
+    INFO(v << "\n" << r.output);
+    CHECK(r.status == 0);
+  }
+}
+
+TEST_CASE("a fine depth past the render's max depth is named in a warning", "[cli]") {
+  // --fine-depth 5 in a direct render rendered the same image as 1 without a word.
+  tiny_scene s;
+  const std::string base = "render " + s.json + " --spp 1 --quiet -o " + (s.dir / "a.pfm");
+  auto r = run_bayeslight(base + " --max-depth 2 --fine-depth 5");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("warning: --fine-depth 5 is above the max depth 2: depths past 2 change nothing") !=
+        std::string::npos);
+  r = run_bayeslight(base + " --max-depth 2 --fine-depth 2");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("warning") == std::string::npos);
+  r = run_bayeslight(base + " --max-depth 2 --fine-depth 5 --sampler uniform");  // the sampler's warning alone
+  INFO(r.output);
+  CHECK(r.output.find("--fine-depth (bound, donikian and bayes only)") != std::string::npos);
+  CHECK(r.output.find("above the max depth") == std::string::npos);
+}
+
+TEST_CASE("help that cannot be written is a failure", "[cli]") {
+  CHECK(run_bayeslight("render --help > /dev/full").status == 1);
+  CHECK(run_bayeslight("render --help > /dev/null").status == 0);
+}
+
+TEST_CASE("an output under a file names the file as not a directory", "[cli]") {
+  tiny_scene s;
+  write_text(s.dir / "afile", "x");
+  auto r = run_bayeslight("render " + s.json + " --spp 1 --quiet -o " + (s.dir / "afile/x.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("afile is not a directory") != std::string::npos);
 }
 
 TEST_CASE("an output through a dangling symlink is the file the link names", "[cli]") {

@@ -341,6 +341,14 @@ TEST_CASE("compare interrupted before any pass keeps an earlier comparison's fil
   std::map<std::string, std::string> after;
   for (auto& e : std::filesystem::directory_iterator(out)) after[e.path().string()] = slurp(e.path().string());
   CHECK(after == before);
+  // A folder the interrupted comparison created is not left behind, empty (a review).
+  const std::string fresh = s.dir / "fresh";
+  st = std::system(("timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " compare " + s.json +
+                    " --reference " + s.ref + " --samplers bayes --out " + fresh +
+                    " --threads 1 --quiet --spp 2 --bayes-oracle 100000000 2>/dev/null").c_str());
+  CHECK(WIFEXITED(st));
+  CHECK(WEXITSTATUS(st) == 130);
+  CHECK(!std::filesystem::exists(fresh));
   // Cut short after uniform's passes, in bayes's warm-up: the summary covers uniform, and the earlier bayes images
   // (which it does not describe) are gone.
   REQUIRE(std::filesystem::exists(out + "/bayes.exr"));
