@@ -182,7 +182,7 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
     for (int c = 0; c < prof_count; c++)
       if (c != prof_shadow) others.push_back({stage_wall(c), stage_name(c)});
     others.push_back({rest, "film, scheduling and timer overhead"});
-    others.push_back({b.learn_seconds, "learning between passes"});
+    others.push_back({b.learn_seconds, "between passes (learning, new regions)"});
     std::sort(others.begin(), others.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
     line("  why: shadow rays are %.1f%% of the timed render; the largest other parts:", 100 * stage_wall(prof_shadow) / b.seconds);
     for (size_t k = 0; k < 3 && k < others.size(); k++)
