@@ -29,11 +29,14 @@ namespace fs = std::filesystem;
 const char* const degenerate_reason =
     "zero area, or an area float maths cannot square: outside about 2e-23 to 9e18 square units; rescale the scene";
 
-// True when triangle (a, b, c) has finite, non-zero area in float: |cross|^2 is a positive finite float.
-static bool good_triangle(vec3f a, vec3f b, vec3f c) {
+// How triangle (a, b, c) fares in float maths: kept (|cross|^2 a positive finite float), flat (cross exactly 0: its
+// corners on one line) or unusable (an area float cannot square: underflow, overflow).
+enum class triangle_fit { kept, flat, unusable };
+static triangle_fit fit_triangle(vec3f a, vec3f b, vec3f c) {
   vec3f n = cross(b - a, c - a);
   float l2 = length_sq(n);
-  return is_finite(n) && l2 > 0 && l2 < inf_f;
+  if (is_finite(n) && l2 > 0 && l2 < inf_f) return triangle_fit::kept;
+  return n.x == 0 && n.y == 0 && n.z == 0 ? triangle_fit::flat : triangle_fit::unusable;
 }
 
 // The unit normal along vn, or false when vn is zero or not finite (that corner then has no normal).
@@ -55,8 +58,9 @@ static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, fo
   std::string path = written;
   std::error_code ec;
   if (!fs::exists(path, ec)) {
-    // A path from the machine that wrote the MTL (C:\Users\...\wood.png), or a name in another case: the file
-    // beside the MTL (a path as it stands), said once per name (later references find it in `loaded`).
+    // A path from the machine that wrote the MTL (C:\Users\...\textures\wood.png), or a name in another case: the
+    // file beside the MTL (find_beside: in its last folder, then alone), said once per name (later references find it
+    // in `loaded`).
     std::string beside = find_beside(dir, name, folders);
     if (!beside.empty()) {
       folders.note(mtl_path, line, statement, name, beside);
@@ -113,7 +117,7 @@ static void check_emitted_power(const std::string& path, const obj_clean_data& c
     if (!(le > 0)) continue;
     vec3f p[3];
     for (int c = 0; c < 3; c++) p[c] = mesh.positions[size_t(mesh.tri_positions[3 * t + size_t(c)])];
-    // (The squared length of the cross product is finite: good_triangle kept only such triangles.)
+    // (The squared length of the cross product is finite: fit_triangle kept only such triangles.)
     double power = le * 0.5 * std::sqrt(double(length_sq(cross(p[1] - p[0], p[2] - p[0])))) * M_PI;
     total += power;
     if (power > max_emitted_power || total > max_emitted_power) {
@@ -237,12 +241,16 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
     for (int i = 0; i < n; i++) corner_pos[size_t(i)] = position(size_t(c[i].v));
     triangulate_polygon(corner_pos, st, local);
     int material = clean.face_materials[face] >= 0 ? clean.face_materials[face] : default_material;
+    int kept = 0, flat = 0, unusable = 0;
     for (size_t t = 0; t < local.size(); t += 3) {
       const obj_corner* tc[3] = {&c[local[t]], &c[local[t + 1]], &c[local[t + 2]]};
-      if (!good_triangle(position(size_t(tc[0]->v)), position(size_t(tc[1]->v)), position(size_t(tc[2]->v)))) {
-        mesh.dropped_degenerate++;
+      triangle_fit fit =
+          fit_triangle(position(size_t(tc[0]->v)), position(size_t(tc[1]->v)), position(size_t(tc[2]->v)));
+      if (fit != triangle_fit::kept) {
+        (fit == triangle_fit::flat ? flat : unusable)++;
         continue;
       }
+      kept++;
       for (const obj_corner* x : tc) {
         mesh.tri_positions.push_back(x->v);
         mesh.tri_normals.push_back(x->vn >= 0 && normal_ok[size_t(x->vn)] ? x->vn : invalid_id);
@@ -250,6 +258,15 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
       }
       mesh.tri_materials.push_back(material);
       if (mesh.tri_materials.size() > size_t(INT_MAX / 3)) throw input_error(path, "too many triangles");
+    }
+    // A face with no triangle left has no area (its corners on one line or at fewer than 3 points, as written or
+    // rounded to float): all n - 2 of its triangles count as degenerate, also those triangulation left out. A face
+    // with area loses nothing with its flat triangles (between corners on one of its edges: T-junction points).
+    if (kept == 0) {
+      mesh.dropped_degenerate += n - 2;
+    } else {
+      mesh.dropped_degenerate += unusable;
+      mesh.dropped_flat += flat;
     }
   }
   std::vector<char> emissive(clean.materials.size() + 1, 0);  // the last: the default material

@@ -1,8 +1,9 @@
 // obj_io: reads a Wavefront OBJ and its MTL files into flat arrays (obj_validate reads them).
 // Invariants: every returned triangle has finite vertices and non-zero float area (degenerate ones are dropped
-// and counted); every index is valid; polygons are triangulated keeping their winding; triangles are in file
-// order and the vertex arrays hold only referenced elements, in file order. Malformed input throws input_error
-// naming the file and, where there is one, the line; the result never depends on hash or pointer order.
+// and counted; flat ones of a face with area are dropped without loss); every index is valid; polygons are
+// triangulated keeping their winding; triangles are in file order and the vertex arrays hold only referenced
+// elements, in file order. Malformed input throws input_error naming the file and, where there is one, the line;
+// the result never depends on hash or pointer order.
 #pragma once
 
 #include "math.h"
@@ -46,7 +47,10 @@ struct mesh_data {
   std::vector<int> tri_materials; // 1 per triangle: index into materials
   std::vector<material_data> materials;
   std::vector<texture_data> textures;
-  int dropped_degenerate = 0;     // zero-area or non-finite triangles removed on load (degenerate_reason)
+  int dropped_degenerate = 0;     // triangles removed on load (degenerate_reason): n - 2 of each face without area
+                                  // (corners on one line or at fewer than 3 points), and those float cannot square
+  int dropped_flat = 0;           // zero-area triangles between corners on one line of a face with area (T-junction
+                                  // points on its edges), removed without loss: not degenerate, not reported
   std::vector<std::string> source_files;  // the OBJ, the MTL files of its used materials, their textures
 };
 

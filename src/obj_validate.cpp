@@ -43,6 +43,17 @@ static std::string quote(string_view t) {
   return q + (t.size() > 40 ? "...'" : "'");
 }
 
+// t with ASCII letters in lower case.
+static std::string ascii_lower(string_view t) {
+  std::string out(t);
+  for (char& c : out) c = char(std::tolower((unsigned char)c));
+  return out;
+}
+
+// Each kind of warning about materials names its first few cases; the rest are counted in one line (a generated file
+// may hold 100k of them).
+constexpr int named_warnings = 3;
+
 std::string read_text_file(const std::string& path, const char* what) {
   std::error_code ec;
   auto status = fs::status(path, ec);
@@ -169,8 +180,7 @@ static bool try_number(string_view t, float& out, std::string* why) {
     return false;
   }
   if (!number_grammar(t, too_big)) {
-    std::string lower;
-    for (char c : t) lower += char(std::tolower((unsigned char)c));
+    std::string lower = ascii_lower(t);
     if (!lower.empty() && (lower[0] == '+' || lower[0] == '-')) lower.erase(0, 1);
     bool special = lower == "nan" || lower == "inf" || lower == "infinity" || lower.compare(0, 4, "nan(") == 0;
     if (why) *why = (special ? "non-finite number " : "malformed number ") + quote(t);
@@ -304,21 +314,23 @@ std::string find_beside(const std::string& dir, const std::string& written, fold
   if (base.empty() || base == "." || base == "..") return {};
   std::error_code ec;
   fs::path folder = dir.empty() ? fs::path(".") : fs::path(dir);
+  // With its last folder first: textures/wood.png of C:\proj\textures\wood.png or of Blender's //textures/wood.png.
+  const std::string head = slash == std::string::npos ? std::string() : name.substr(0, slash);
+  const std::string parent = head.substr(head.find_last_of("/\\") + 1);  // (npos + 1 = 0: all of head)
+  fs::path in_parent = folder / parent / base;
+  if (!parent.empty() && parent != "." && parent != ".." && fs::is_regular_file(in_parent, ec))
+    return in_parent.lexically_normal().string();
   fs::path exact = folder / base;
   if (fs::is_regular_file(exact, ec)) return exact.lexically_normal().string();
-  auto lower = [](std::string x) {
-    for (char& c : x) c = char(std::tolower((unsigned char)c));
-    return x;
-  };
   auto [listing, fresh] = cache.folders.try_emplace(folder.lexically_normal().string());
   if (fresh)
     for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
       std::error_code type_ec;
       if (!it->is_regular_file(type_ec)) continue;  // (files only: a folder of the same name is no rival)
       std::string entry = it->path().filename().string();
-      listing->second[lower(entry)].push_back(entry);
+      listing->second[ascii_lower(entry)].push_back(entry);
     }
-  auto same = listing->second.find(lower(base));
+  auto same = listing->second.find(ascii_lower(base));
   if (same == listing->second.end() || same->second.size() != 1) return {};  // (two that differ only in case: neither
                                                                              // is more right)
   fs::path found = folder / same->second[0];
@@ -406,7 +418,7 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
   unknown_log unknown;
   mtl_material_data* cur = nullptr;
   size_t first = out.size();
-  std::vector<char> has_kd;  // per material of this file: a Kd statement was seen
+  std::vector<size_t> kd_line;  // per material of this file: the line of its last Kd statement (0: none)
   size_t transparent_line = 0;  // the first d or Tr statement asking for partial transparency (reported once)
   std::map<std::string, size_t> ignored_maps;  // texture statements other than map_Kd and map_d: first line of each
   std::vector<std::string> ignored_order;     // their keywords in order of first appearance
@@ -417,6 +429,9 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     bool commented = tokenize(line, pos, t);
     if (t.empty()) continue;
     string_view k = t[0];
+    // map_Kd and map_d in any case (map_kd, MAP_D), as Assimp and three.js read them; other keywords as written.
+    const std::string lower_k = ascii_lower(k);
+    if (lower_k == "map_kd" || lower_k == "map_d") k = lower_k == "map_kd" ? "map_Kd" : "map_d";
     bool texture =
         k.compare(0, 4, "map_") == 0 || k == "bump" || k == "disp" || k == "decal" || k == "refl" || k == "norm";
     if (k == "newmtl" || texture) {
@@ -428,7 +443,7 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       out.emplace_back();
       cur = &out.back();
       cur->material.name = join_from(named, 1);
-      has_kd.push_back(0);
+      kd_line.push_back(0);
       cur->mtl_path = path;
       cur->line = int(std::min<size_t>(lines.line, INT_MAX));
       continue;
@@ -474,7 +489,7 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
         fail(pos, quote(k) + " " + std::string(t[1]) + " (" + (t[1] == "xyz" ? "CIE XYZ" : "a spectral curve") +
                       ") is not supported: write " + std::string(k) + " r g b (linear RGB)");
       vec3f c = colour_at(t, pos);
-      if (k == "Kd") m.kd = c, has_kd.back() = 1;
+      if (k == "Kd") m.kd = c, kd_line.back() = lines.line;
       if (k == "Ks") m.ks = c;
       if (k == "Ke") m.ke = c;
     } else {
@@ -486,6 +501,11 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       if (((k == "d" && v < 1) || (k == "Tr" && v > 0)) && transparent_line == 0) transparent_line = lines.line;
     }
   }
+  // A material without Kd has no diffuse part (Kd 0, as tinyobjloader reads it: a lamp written with Ke alone does
+  // not also reflect, a lobe written with Ks and Ns alone stays a pure lobe), unless it has a map_Kd: then it shows
+  // the texture as it is (Kd multiplies the texture, as the MTL format says).
+  for (size_t i = first; i < out.size(); i++)
+    if (kd_line[i - first] == 0) out[i].material.kd = out[i].kd_map.empty() ? vec3f{0, 0, 0} : vec3f{1, 1, 1};
   // Kd + Ks above 1 reflects more than arrives: make_bsdf scales such a material down (one line per file, naming
   // the first few).
   std::vector<std::string> bright;
@@ -511,11 +531,20 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
   if (transparent_line > 0)
     stderr_text() << "warning: " << path << ":" << transparent_line
                   << ": dissolve (d below 1 or Tr above 0) is not rendered, surfaces stay opaque; map_d cuts out\n";
-  // A material without Kd has no diffuse part (Kd 0, as tinyobjloader reads it: a lamp written with Ke alone does
-  // not also reflect, a lobe written with Ks and Ns alone stays a pure lobe), unless it has a map_Kd: then it shows
-  // the texture as it is (Kd multiplies the texture, as the MTL format says).
-  for (size_t i = first; i < out.size(); i++)
-    if (!has_kd[i - first]) out[i].material.kd = out[i].kd_map.empty() ? vec3f{0, 0, 0} : vec3f{1, 1, 1};
+  // A map_Kd under an explicit Kd 0 (as Maya writes textured materials) is multiplied by 0 and never shows. Not said
+  // of emitters: they show their Ke, and a lamp that does not reflect is a choice.
+  int unseen = 0;
+  for (size_t i = first; i < out.size(); i++) {
+    const material_data& m = out[i].material;
+    if (kd_line[i - first] == 0 || !is_black(m.kd) || out[i].kd_map.empty() || !is_black(m.ke)) continue;
+    if (unseen++ < named_warnings)
+      stderr_text() << "warning: " << path << ":" << kd_line[i - first] << ": material " << quote(m.name)
+                    << " has map_Kd but Kd 0: it renders " << (is_black(m.ks) ? "black" : "as its Ks lobe alone")
+                    << " (map_Kd multiplies Kd)\n";
+  }
+  if (unseen > named_warnings)
+    stderr_text() << "warning: " << path << ": " << unseen - named_warnings
+                  << " more materials have map_Kd but Kd 0 (map_Kd multiplies Kd)\n";
   unknown.report(path);
 }
 
@@ -568,6 +597,7 @@ obj_clean_data validate_obj(const std::string& path) {
   st.folders = &d.folders;
   unknown_log unknown;
   int current = invalid_id;  // material k of the next faces
+  size_t colour_line = 0;    // the first v with a colour (x y z r g b; reported once)
   line_reader lines(text);
   std::vector<string_view> t;
   string_view line;
@@ -594,6 +624,7 @@ obj_clean_data validate_obj(const std::string& path) {
       size_t count = k == "v" ? d.positions.size() : k == "vn" ? d.normals.size() : d.texcoords.size();
       if (count >= size_t(INT_MAX - 1)) fail(pos, "too many " + std::string(k) + " statements");
       if (k == "v") d.positions.push_back({x[0], x[1], x[2]});
+      if (k == "v" && args == 6 && colour_line == 0) colour_line = lines.line;
       if (k == "vn") d.normals.push_back({x[0], x[1], x[2]});
       if (k == "vt") d.texcoords.push_back({x[0], x[1]});
     } else if (k == "f") {
@@ -622,11 +653,13 @@ obj_clean_data validate_obj(const std::string& path) {
     }
   }
   unknown.report(path);
+  if (colour_line > 0)
+    stderr_text() << "warning: " << path << ":" << colour_line
+                  << ": vertex colours (v x y z r g b) are not rendered; materials give the colour (Kd, map_Kd)\n";
   text = std::string();
 
-  // Resolve the used names (first definition wins, as in tinyobjloader) in order of first use. Each kind of warning
-  // names its first few cases; the rest are counted in one line (a generated file may hold 100k of them).
-  constexpr int named_warnings = 3;
+  // Resolve the used names (first definition wins, as in tinyobjloader) in order of first use; warnings name the
+  // first named_warnings cases.
   std::map<std::string, int> defined_index;
   int redefined = 0, undefined = 0, approximate = 0;
   for (size_t i = 0; i < st.defined.size(); i++)

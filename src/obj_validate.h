@@ -60,8 +60,9 @@ obj_clean_data validate_obj(const std::string& path);
 // when the name as written is not a file.
 std::string resolve_file_name(const std::string& dir, const std::string& written);
 // Where a file named `written` that resolve_file_name did not find may be after all, as other readers look for it:
-// its last path component (after '/' or '\\': a path from the machine that wrote the file) in folder dir, written
-// exactly, else the one entry of dir equal to it but for ASCII case; "" when there is none.
+// its last two path components (after '/' or '\\': a path from the machine that wrote the file, textures/wood.png
+// of C:\proj\textures\wood.png), else its last one, in folder dir, written exactly, else the one entry of dir equal to
+// the last one but for ASCII case; "" when there is none.
 std::string find_beside(const std::string& dir, const std::string& written, folder_cache& cache);
 
 // Reads a whole regular file; throws input_error (naming what, e.g. "material library") when it cannot.
