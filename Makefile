@@ -44,7 +44,7 @@ golden: build
 	@tools/golden.sh $(BIN)
 
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) $(FUZZ_BUILD) $(SANITIZE_BUILD)
 
 # ---- Robustness (issue 5): fuzzing and sanitizers, each in its own build folder. -----------------------------
 # make fuzz: installs clang + libFuzzer if missing, builds fuzz_{scene,obj,texture,image} (-DBAYESLIGHT_FUZZ=ON)
