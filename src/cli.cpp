@@ -550,7 +550,8 @@ void add_render_options(CLI::App* r, render_options& o) {
       // Pair offsets are int: fine and coarse pairs (each up to the budget) must stay below 2^31.
       ->check(CLI::Range(int64_t(1), int64_t(1) << 29))->group(grp);
   const char* bg = bayes_group;
-  r->add_option("--bayes-pmf", o.bayes_pmf, "second-moment (the paper; default) or mean (ablation: PMF from the mean only)")
+  r->add_option("--bayes-pmf", o.bayes_pmf,
+                "second-moment (the paper; default) or mean (ablation: PMF from the mean only)")
       ->check(CLI::IsMember({"second-moment", "mean"}))->group(bg);
   r->add_option("--bayes-prior", o.bayes_prior,
                 "region (default: prior mean per region and cluster, a point only scales it by 1/d^2) or point "
