@@ -100,6 +100,7 @@ hit_info intersect_triangle(const scene_data& s, int tri, vec3f org, vec3f dir) 
     vec3f c = s.tri_p0[tri] + (e1 + e2) * (1.0f / 3.0f);
     h.t = std::max(0.0f, dot(c - org, dir));
     h.b1 = h.b2 = 1.0f / 3.0f;
+    h.p = interpolated_point(s, tri, h.b1, h.b2);
     return h;
   }
   float inv = 1.0f / det;
@@ -119,6 +120,18 @@ hit_info intersect_triangle(const scene_data& s, int tri, vec3f org, vec3f dir) 
   h.t = std::max(t, 0.0f);
   h.b1 = b1;
   h.b2 = b2;
+  // (see hit_info: 16 times the ray's scale; in scenes of ordinary proportions every point is interpolated)
+  const vec3f p0 = s.tri_p0[tri];
+  const float corners = std::max({max_abs_component(p0), max_abs_component(p0 + e1), max_abs_component(p0 + e2)});
+  if (corners > 16 * (max_abs_component(org) + h.t)) {
+    // org + t dir errs off the plane by the ray's rounding, which can exceed the offsets at a point much nearer the
+    // origin than the ray's (ray_epsilon): moved onto the plane it errs by the plane's rounding (tri_extent) and the
+    // point's only, as an interpolated point does, exactly so on a plane such as y = 0.
+    const vec3f n = s.tri_ng[tri], q = org + dir * h.t;
+    h.p = q - n * (dot(n, q) - dot(n, p0));
+  } else {
+    h.p = interpolated_point(s, tri, b1, b2);
+  }
   return h;
 }
 

@@ -27,10 +27,15 @@ struct bvh_data {
 // Builds the acceleration structure; `scene` must outlive the result (the alpha filter reads it).
 bvh_data build_bvh(const scene_data& scene);
 
-// A closest hit: triangle, distance along the (unit) ray direction and barycentrics of corners 1 and 2.
+// A closest hit: triangle, distance along the (unit) ray direction, barycentrics of corners 1 and 2, and the point.
+// The point is interpolated from the corners, except on a triangle whose corners lie far beyond the ray's own scale
+// (|org| + t): there the corners' rounding (a ground quad reaching 1e6 around a room errs by a tenth of a unit at the
+// room) would slide the point along the surface, out from under a wall or across a shadow's edge, so it is
+// org + t dir, which errs by the ray's rounding.
 struct hit_info {
   int tri = invalid_id;
   float t = 0, b1 = 0, b2 = 0;
+  vec3f p = {0, 0, 0};
 };
 
 // Closest hit of the ray org + t*dir, t in (tnear, tmax); tri == invalid_id on a miss.

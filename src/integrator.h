@@ -151,7 +151,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       }
       break;
     }
-    surface_point sp = eval_surface(scene, h.tri, h.b1, h.b2, dir);
+    surface_point sp = eval_surface(scene, h.tri, h.b1, h.b2, h.p, dir);
     vec3f wo = -dir;
     int hit_light = lights.light_of_tri[h.tri];
     if (hit_light != invalid_id) {

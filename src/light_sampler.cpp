@@ -29,7 +29,7 @@ std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_g
         vec3f dir = camera_ray_dir(in.camera, float(x) + 0.5f, float(y) + 0.5f);
         hit_info hit = intersect(*in.bvh, in.camera.eye, dir);
         if (hit.tri == invalid_id) continue;
-        surface_point sp = eval_surface(*in.scene, hit.tri, hit.b1, hit.b2, dir);
+        surface_point sp = eval_surface(*in.scene, hit.tri, hit.b1, hit.b2, hit.p, dir);
         uint64_t key = fine_region_key(grid, sp.p);
         if (row.empty() || row.back() != key) row.push_back(key);  // neighbours often share a cell
       }

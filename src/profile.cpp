@@ -48,7 +48,7 @@ ray_set make_shadow_rays(const scene_data& scene, const bvh_data& bvh, const lig
         vec3f d = camera_ray_dir(cam, float(x) + c.u[0], float(y) + c.u[1]);
         hit_info h = intersect(bvh, cam.eye, d);
         if (h.tri == invalid_id) continue;
-        surface_point sp = eval_surface(scene, h.tri, h.b1, h.b2, d);
+        surface_point sp = eval_surface(scene, h.tri, h.b1, h.b2, h.p, d);
         int light = std::min(int(v.u[0] * float(lights.count)), lights.count - 1);
         light_sample ls = sample_light_point(lights, scene, light, sp.p, v.u[2], v.u[3]);
         if (!(ls.pdf > 0)) continue;

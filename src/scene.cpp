@@ -33,7 +33,13 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
     s.tri_e2[t] = e2;
     s.tri_ng[t] = len > 0 ? c / len : vec3f{0, 0, 1};
     s.tri_area[t] = 0.5f * len;
-    s.tri_extent[t] = std::max({max_abs_component(p0), max_abs_component(p1), max_abs_component(p2)});
+    // How far the corners' rounding can move an interpolated point off the plane: only the coordinates along the
+    // normal count (a point on a huge floor at y = 0 has an exact y however far its corners lie in x and z).
+    vec3f big = {std::max({std::fabs(p0.x), std::fabs(p1.x), std::fabs(p2.x)}),
+                 std::max({std::fabs(p0.y), std::fabs(p1.y), std::fabs(p2.y)}),
+                 std::max({std::fabs(p0.z), std::fabs(p1.z), std::fabs(p2.z)})};
+    vec3f ng = s.tri_ng[t];
+    s.tri_extent[t] = std::fabs(ng.x) * big.x + std::fabs(ng.y) * big.y + std::fabs(ng.z) * big.z;
     s.bounds = merge(merge(merge(s.bounds, p0), p1), p2);
   }
   // Reversed twins: of the triangles with the same three corners (grouped by a hash of the corner set, independent
@@ -109,13 +115,13 @@ scene_data build_scene(const scene_desc& desc, float aspect) {
   return s;
 }
 
-surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f dir) {
+surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f p, vec3f dir) {
   const mesh_data& m = scene.mesh;
   surface_point sp;
   sp.tri = tri;
   sp.material = m.tri_materials[tri];
   float b0 = 1.0f - b1 - b2;
-  sp.p = scene.tri_p0[tri] + scene.tri_e1[tri] * b1 + scene.tri_e2[tri] * b2;
+  sp.p = p;
   vec3f ng = scene.tri_ng[tri];
   sp.front = dot(ng, dir) < 0;
   sp.ng = sp.front ? ng : -ng;

@@ -20,7 +20,8 @@ struct scene_data {
   std::vector<vec3f> tri_ng;                  // unit geometric normal, cross(e1, e2) direction (CCW front)
   std::vector<float> tri_area;
   std::vector<uint8_t> material_emissive;     // per material: Ke non-zero
-  std::vector<float> tri_extent;              // largest |coordinate| of the triangle's corners (ray offsets)
+  std::vector<float> tri_extent;              // sum over axes of |normal_a| max |corner_a| (ray offsets: how far
+                                              // the corners' rounding moves an interpolated point off the plane)
   // Per triangle: its reversed twin (the same corners in the opposite order: the other face of a two-faced sheet,
   // e.g. a lamp emitting on both sides from two faces), or invalid_id; empty when no triangle has one.
   std::vector<int> tri_twin;
@@ -48,17 +49,26 @@ struct surface_point {
   bool front = true;  // the ray arrived on the front (CCW) side of the triangle
 };
 
-// Barycentric point (b1, b2) of triangle t seen by a ray with direction `dir`.
-surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f dir);
+// The point of triangle tri at barycentrics (b1, b2).
+inline vec3f interpolated_point(const scene_data& scene, int tri, float b1, float b2) {
+  return scene.tri_p0[size_t(tri)] + scene.tri_e1[size_t(tri)] * b1 + scene.tri_e2[size_t(tri)] * b2;
+}
+// Point p, at barycentrics (b1, b2) of triangle tri, seen by a ray with direction `dir`.
+surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f p, vec3f dir);
+// Barycentric point (b1, b2) of triangle tri seen by a ray with direction `dir`.
+inline surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f dir) {
+  return eval_surface(scene, tri, b1, b2, interpolated_point(scene, tri, b1, b2), dir);
+}
 // Texture coordinates of triangle tri at barycentrics (b1, b2) ((0, 0) without vt).
 vec2f surface_uv(const scene_data& scene, int tri, float b1, float b2);
 // Whether that point is a hole of its material's map_d cut-out (alpha < 0.5): no hit, no shadow, no emission.
 bool alpha_hole(const scene_data& scene, int tri, float b1, float b2);
 
 // Distance to offset a ray origin at p, a point of triangle tri, off its surface: a share of p's largest coordinate,
-// and at least a share of the triangle's own largest (a point near the origin on a huge triangle is interpolated from
-// corners far from it and errs by their rounding). Per triangle, so that far geometry (a ground plane reaching 1e8)
-// does not move rays off the small things near the origin by more than their size.
+// and at least a share of the triangle's own coordinates along its normal (tri_extent: a point near the origin on a
+// huge tilted triangle is interpolated from corners far from it and errs off its plane by their rounding; on a huge
+// floor at y = 0 its y is exact). Per triangle, so that far geometry (a ground plane reaching 1e8) does not move rays
+// off the small things near the origin by more than their size, nor, when the ground is also the floor, off the floor.
 inline float ray_epsilon(const scene_data& scene, int tri, vec3f p) {
   return 2e-5f * std::max(max_abs_component(p), 0.5f * scene.tri_extent[size_t(tri)]);
 }

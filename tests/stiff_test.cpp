@@ -424,6 +424,57 @@ TEST_CASE("a glossy floor mirroring disk lamps renders consistently with every s
   }
 }
 
+TEST_CASE("a room on a ground quad reaching 1e6 renders as on a ground split around it", "[stiff]") {
+  // A 4 x 3 x 4 room with a window, a sun and a ceiling lamp, standing on a ground written as one quad of side E (also
+  // the room's floor) or as a 20 x 20 quad under the room with four large ones around it. With one quad of side 1e6
+  // the image mean was 1.43 times the split ground's (a review): points on it, interpolated from corners 5e5 away,
+  // slid by a tenth of a unit (the sun's patch moved, light leaked under the walls), and the ray offsets, scaled by
+  // the corners' size, lifted shadow rays by a quarter of a unit.
+  auto scene_of = [](float e, bool split) {
+    mesh_builder m;
+    int ground = m.add_material({0.5f, 0.5f, 0.5f}), wall = m.add_material({0.7f, 0.7f, 0.7f});
+    int lamp = m.add_material({0, 0, 0}, {20, 20, 20});
+    const float h = e / 2;
+    if (!split) {
+      m.add_quad({-h, 0, -h}, {-h, 0, h}, {h, 0, h}, {h, 0, -h}, ground);
+    } else {
+      m.add_quad({-10, 0, -10}, {-10, 0, 10}, {10, 0, 10}, {10, 0, -10}, ground);
+      m.add_quad({-h, 0, -h}, {-h, 0, h}, {-10, 0, h}, {-10, 0, -h}, ground);
+      m.add_quad({10, 0, -h}, {10, 0, h}, {h, 0, h}, {h, 0, -h}, ground);
+      m.add_quad({-10, 0, -h}, {-10, 0, -10}, {10, 0, -10}, {10, 0, -h}, ground);
+      m.add_quad({-10, 0, 10}, {-10, 0, h}, {10, 0, h}, {10, 0, 10}, ground);
+    }
+    const float y0 = 0.001f;
+    m.add_quad({-2, 3, -2}, {2, 3, -2}, {2, 3, 2}, {-2, 3, 2}, wall);
+    m.add_quad({-2, y0, -2}, {2, y0, -2}, {2, 3, -2}, {-2, 3, -2}, wall);
+    m.add_quad({-2, y0, 2}, {-2, 3, 2}, {2, 3, 2}, {2, y0, 2}, wall);
+    m.add_quad({-2, y0, -2}, {-2, 3, -2}, {-2, 3, 2}, {-2, y0, 2}, wall);
+    m.add_quad({2, y0, -2}, {2, 1, -2}, {2, 1, 2}, {2, y0, 2}, wall);  // +x wall around a window
+    m.add_quad({2, 2, -2}, {2, 3, -2}, {2, 3, 2}, {2, 2, 2}, wall);
+    m.add_quad({2, 1, -2}, {2, 2, -2}, {2, 2, -1}, {2, 1, -1}, wall);
+    m.add_quad({2, 1, 1}, {2, 2, 1}, {2, 2, 2}, {2, 1, 2}, wall);
+    m.add_quad({-1.2f, 2.99f, -0.2f}, {-0.8f, 2.99f, -0.2f}, {-0.8f, 2.99f, 0.2f}, {-1.2f, 2.99f, 0.2f}, lamp);
+    return build_test_scene(std::move(m.mesh), fixed_camera({-1.8f, 1.5f, 1.8f}, {2, 1, -1}, 70),
+                            test_sun({1, 0.4f, 0.2f}, {500, 480, 450}));
+  };
+  render_params p;
+  p.width = 32;
+  p.height = 24;
+  p.spp = 8;
+  p.max_depth = 1;
+  p.threads = 2;
+  p.sampler.kind = sampler_kind::uniform;
+  auto mean_of = [&](const test_scene& t) {
+    return mean_and_se(pixel_luminance(render(t.scene, t.bvh, t.lights, p))).mean;
+  };
+  for (float e : {1e3f, 1e5f, 1e6f}) {
+    INFO("ground of side " << e);
+    const double expected = mean_of(*scene_of(e, true));
+    REQUIRE(expected > 0);
+    CHECK(mean_of(*scene_of(e, false)) == Approx(expected).epsilon(1e-4));
+  }
+}
+
 TEST_CASE("the image of a film is its mean, values below zero included", "[stiff]") {
   // bayes's control variates give unbiased pixel means that are noisy around a true zero, so a few are below it.
   // Writing those as zero made the image's mean biased upward (26x at 64 spp where most pixels' means were below
