@@ -126,8 +126,10 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
   vec3f ext = extent(b);
   float longest = std::max(max_component(ext), 1e-20f);
   float shortest = std::min(ext.x, std::min(ext.y, ext.z));
-  // A flat scene has no shortest extent: use a thousandth of the longest one instead.
-  shortest = std::max(shortest, 1e-3f * longest);
+  // A flat scene (one plane, up to rounding) has no shortest extent: use a thousandth of the longest one instead. A
+  // scene that is only thin for its size (a room on a ground plane reaching 1e5) keeps its own: with a thousandth of
+  // the ground's side the room fitted in a few cells (max_cells_per_axis still bounds the count).
+  if (!(shortest > 1e-7f * longest)) shortest = 1e-3f * longest;
   float cell = shortest / float(std::max(1, params.grid));
   cell = std::max(cell, longest / float(max_cells_per_axis - 1));
   g.origin = b.lo;
