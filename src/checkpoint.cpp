@@ -18,8 +18,9 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 2: pass schedule, lazy refold; 3: weighted passes (film weight); 4: z = Y d^2 / cos; 5: mean hierarchy (k_folded);
 // 6: bayes fallback check; 7: no point-prior weights in region-prior mode; 8: the stratified set's first sample;
 // 9: members; 10: reversed twin faces (a ray meets the one turned toward it); 11: hashed per-vertex PCG32 seeds; 12: the
-// reference's hash; 13: the region options as resolved in the fingerprint, Kd 0 for a library material without one
-constexpr uint32_t version = 13;
+// reference's hash; 13: the region options as resolved in the fingerprint, Kd 0 for a library material without one;
+// 14: hits on huge triangles take the ray's point, a thin scene's cells its own shortest extent
+constexpr uint32_t version = 14;
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
