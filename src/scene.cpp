@@ -38,8 +38,10 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
     vec3f big = {std::max({std::fabs(p0.x), std::fabs(p1.x), std::fabs(p2.x)}),
                  std::max({std::fabs(p0.y), std::fabs(p1.y), std::fabs(p2.y)}),
                  std::max({std::fabs(p0.z), std::fabs(p1.z), std::fabs(p2.z)})};
+    // (That sum is at most sqrt(3) times the largest corner coordinate, which bounds the rounding too: the smaller.)
     vec3f ng = s.tri_ng[t];
-    s.tri_extent[t] = std::fabs(ng.x) * big.x + std::fabs(ng.y) * big.y + std::fabs(ng.z) * big.z;
+    s.tri_extent[t] = std::min(std::fabs(ng.x) * big.x + std::fabs(ng.y) * big.y + std::fabs(ng.z) * big.z,
+                               std::max({big.x, big.y, big.z}));
     s.bounds = merge(merge(merge(s.bounds, p0), p1), p2);
   }
   // Reversed twins: of the triangles with the same three corners (grouped by a hash of the corner set, independent
