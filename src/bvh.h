@@ -29,9 +29,9 @@ bvh_data build_bvh(const scene_data& scene);
 
 // A closest hit: triangle, distance along the (unit) ray direction, barycentrics of corners 1 and 2, and the point.
 // The point is interpolated from the corners, except on a triangle whose corners lie far beyond the ray's own scale
-// (|org| + t): there the corners' rounding (a ground quad reaching 1e6 around a room errs by a tenth of a unit at the
-// room) would slide the point along the surface, out from under a wall or across a shadow's edge, so it is
-// org + t dir, which errs by the ray's rounding.
+// (more than 16 (|org| + t)): there the corners' rounding (a ground quad reaching 1e6 around a room errs by a tenth
+// of a unit at the room) would slide the point along the surface, out from under a wall or across a shadow's edge,
+// so it is the ray's point on the plane of the exact corners, computed in double and rounded once.
 struct hit_info {
   int tri = invalid_id;
   float t = 0, b1 = 0, b2 = 0;

@@ -20,8 +20,9 @@ struct scene_data {
   std::vector<vec3f> tri_ng;                  // unit geometric normal, cross(e1, e2) direction (CCW front)
   std::vector<float> tri_area;
   std::vector<uint8_t> material_emissive;     // per material: Ke non-zero
-  std::vector<float> tri_extent;              // sum over axes of |normal_a| max |corner_a| (ray offsets: how far
-                                              // the corners' rounding moves an interpolated point off the plane)
+  std::vector<float> tri_extent;              // sum over axes of |normal_a| max |corner_a|, at most the largest
+                                              // |corner coordinate| (ray offsets: how far the corners' rounding
+                                              // moves an interpolated point off the plane)
   // Per triangle: its reversed twin (the same corners in the opposite order: the other face of a two-faced sheet,
   // e.g. a lamp emitting on both sides from two faces), or invalid_id; empty when no triangle has one.
   std::vector<int> tri_twin;
