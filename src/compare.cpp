@@ -160,13 +160,14 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
   if (all.empty() || all[0].runs == 0) return all;
   const compare_stats& base = all[0];
   for (compare_stats& st : all) {
-    if (st.runs == 0 || st.before_first_pass || base.before_first_pass) {
+    if (st.runs == 0) {
       st.speedup = NAN;
-      if (st.runs == 0) continue;
+      continue;
     }
     double num = data.equal_time ? base.relmse : base.relmse * base.seconds;
     double den = data.equal_time ? st.relmse : st.relmse * st.seconds;
-    if (!std::isnan(st.speedup)) st.speedup = den > 0 && std::isfinite(num) && std::isfinite(den) ? num / den : NAN;
+    const bool comparable = !st.before_first_pass && !base.before_first_pass;  // (both errors at the same time)
+    st.speedup = comparable && den > 0 && std::isfinite(num) && std::isfinite(den) ? num / den : NAN;
     // The first sampler reaches its own relMSE at its end by definition: at the budget at equal time (its curve can
     // rise again in the pass after it, heavy-tailed as relMSE is), which is at the shortest run's last pass when a
     // signal stopped them sooner; at its mean time at equal spp (where its curve's last point, the mean of sums, can

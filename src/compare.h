@@ -65,7 +65,7 @@ struct compare_stats {
   int spp_min = 0, spp_max = 0;      // final spp over runs
   double seconds = 0;                // mean final render time
   double relmse = 0, relmse_sd = 0;  // mean and sample standard deviation over runs of the relMSE at the end: at
-                                     // exactly the time budget (relmse_at_time) at equal time, else the final one
+                                     // exactly comparison_time (relmse_at_time) at equal time, else the final one
   double setup_seconds = 0;          // mean setup time (light tree, regions; not in `seconds`)
   double speedup = 0;                // against the first sampler (NaN when undefined)
   bool before_first_pass = false;    // equal time: a run's first pass ended after the comparison time, so its relmse
