@@ -124,8 +124,9 @@ hit_info intersect_triangle(const scene_data& s, int tri, vec3f org, vec3f dir) 
   const vec3f p0 = s.tri_p0[tri];
   const float corners = std::max({max_abs_component(p0), max_abs_component(p0 + e1), max_abs_component(p0 + e2)});
   if (corners > 16 * (max_abs_component(org) + h.t)) {
-    // The ray's point on the plane of the triangle's exact corners, in double: the float t above errs with the
-    // corners' rounding too (0.03 along the ray at a room on a ground quad of 1e6 tilted 30 degrees). Rounded once.
+    // The ray's distance to the plane of the triangle's exact corners and its point there, in double (each operation
+    // rounds at double precision), then rounded to float: the float t above errs with the corners' rounding too (0.03
+    // along the ray at a room on a ground quad of 1e6 tilted 30 degrees).
     vec3f c[3];
     for (int k = 0; k < 3; k++) c[k] = s.mesh.positions[size_t(s.mesh.tri_positions[3 * size_t(tri) + size_t(k)])];
     double e[2][3], n[3], w[3];
@@ -138,7 +139,8 @@ hit_info intersect_triangle(const scene_data& s, int tri, vec3f org, vec3f dir) 
     n[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
     n[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
     const double nd = n[0] * double(dir.x) + n[1] * double(dir.y) + n[2] * double(dir.z);
-    const double t = nd != 0 ? (n[0] * w[0] + n[1] * w[1] + n[2] * w[2]) / nd : double(h.t);
+    const double t = nd != 0 ? std::max((n[0] * w[0] + n[1] * w[1] + n[2] * w[2]) / nd, 0.0) : double(h.t);
+    h.t = float(t);
     h.p = {float(double(org.x) + double(dir.x) * t), float(double(org.y) + double(dir.y) * t),
            float(double(org.z) + double(dir.z) * t)};
   } else {

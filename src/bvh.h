@@ -1,7 +1,8 @@
 // bvh: owns the Embree 3 device and scene; answers closest-hit and occlusion queries.
 // Invariants: only hit/miss and the primitive id come from Embree (they are identical on every x86-64 CPU);
-// distance and barycentrics are recomputed by `intersect_triangle` in our own float code, also inside the
-// alpha cut-out filter, so images never depend on Embree's ISA-specific arithmetic.
+// distance, barycentrics and the point are recomputed by `intersect_triangle` in our own code (float; double for the
+// point on a huge triangle), also inside the alpha cut-out filter, so images never depend on Embree's ISA-specific
+// arithmetic.
 #pragma once
 
 #include "math.h"
@@ -43,7 +44,8 @@ hit_info intersect(const bvh_data& bvh, vec3f org, vec3f dir, float tmax = inf_f
 // Whether anything blocks the segment org + t*dir, t in (0, tmax).
 bool occluded(const bvh_data& bvh, vec3f org, vec3f dir, float tmax);
 
-// Our own ray/triangle distance and barycentrics (Moller-Trumbore in float), clamped onto the triangle.
+// Our own ray/triangle distance and barycentrics (Moller-Trumbore in float), clamped onto the triangle, and the point
+// (hit_info: on a triangle far larger than the ray's scale, distance and point from the exact corners' plane in double).
 hit_info intersect_triangle(const scene_data& scene, int tri, vec3f org, vec3f dir);
 
 }  // namespace bl

@@ -165,13 +165,6 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.pass_weighting = o.pass_weighting;
   p.stratify = !o.independent;
   p.progress = p.notes = !o.quiet && stderr_is_terminal();
-  // Fine regions at depths the paths never reach change nothing either (warn_unused_options runs before the scene,
-  // which may give the max depth, is read).
-  bool fine_depth_given = false;
-  for (const auto& given : o.given) fine_depth_given |= given.first == "--fine-depth";
-  if (fine_depth_given && o.regions.fine_depth > p.max_depth && unused_because("--fine-depth", region_group, kind, o).empty())
-    std::fprintf(stderr, "bayeslight: warning: --fine-depth %d is above the max depth %d: depths past %d change nothing\n",
-                 o.regions.fine_depth, p.max_depth, p.max_depth);
   return p;
 }
 
@@ -228,6 +221,17 @@ void warn_unused_options(const render_options& o, const std::vector<sampler_kind
                  unused.c_str());
 }
 
+// Fine regions at depths the paths never reach change nothing either: named in a warning when a sampler of `kinds`
+// has regions (warn_unused_options runs before the scene, which may give the max depth, is read).
+void warn_fine_depth(const render_options& o, int max_depth, const std::vector<sampler_kind>& kinds) {
+  bool given = false, used = false;
+  for (const auto& g : o.given) given |= g.first == "--fine-depth";
+  for (sampler_kind k : kinds) used |= unused_because("--fine-depth", region_group, k, o).empty();
+  if (given && used && o.regions.fine_depth > max_depth)
+    std::fprintf(stderr, "bayeslight: warning: --fine-depth %d is above the max depth %d: depths past %d change nothing\n",
+                 o.regions.fine_depth, max_depth, max_depth);
+}
+
 int run_render(const render_options& o) {
   install_interrupt_handlers();  // (a signal while the scene loads ends the command at once)
   sampler_kind kind;
@@ -270,6 +274,7 @@ int run_render(const render_options& o) {
 
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
+  warn_fine_depth(o, params.max_depth, {kind});
   if (o.frames > 1 && !(desc.sun.enabled && desc.sun.animated))
     std::fprintf(stderr, "%s: warning: %s, so the %d frames show the same scene (the sun moves to sun.direction_end)\n",
                  o.scene.c_str(), desc.sun.enabled ? "the sun has no \"direction_end\"" : "the scene has no sun",
@@ -428,6 +433,7 @@ int run_diff(const diff_options& o) {
 }
 
 // Rejects NaN and infinities: CLI::Range and CLI::PositiveNumber let NaN through (every comparison with it is false).
+// (decimal_number refuses "nan" and "inf" as text; this also catches a decimal that overflows, such as 1e400.)
 const CLI::Validator finite_number(
     [](std::string& text) -> std::string {
       char* end = nullptr;
@@ -465,10 +471,12 @@ const CLI::Validator decimal_number(
         while (j < text.size() && text[j] >= '0' && text[j] <= '9') j++;
         return j;
       };
-      size_t i = text.size() > 1 && text[0] == '-' ? 1 : 0;
-      size_t int_end = digits(i), end = int_end;
-      if (end < text.size() && text[end] == '.') end = digits(end + 1);
-      bool mantissa = int_end > i || end > int_end + 1;  // digits before or after the point
+      const size_t first = text.size() > 1 && text[0] == '-' ? 1 : 0;
+      const size_t int_end = digits(first);
+      size_t mantissa_end = int_end;
+      if (mantissa_end < text.size() && text[mantissa_end] == '.') mantissa_end = digits(mantissa_end + 1);
+      const bool mantissa = int_end > first || mantissa_end > int_end + 1;  // digits before or after the point
+      size_t end = mantissa_end;
       if (mantissa && end < text.size() && (text[end] == 'e' || text[end] == 'E')) {
         size_t e = end + 1;
         if (e < text.size() && (text[e] == '-' || text[e] == '+')) e++;
@@ -476,6 +484,8 @@ const CLI::Validator decimal_number(
         end = e_end > e ? e_end : std::string::npos;  // an exponent needs digits
       }
       if (!mantissa || end != text.size()) return "Value " + text + " is not a decimal number";
+      // "-0" is 0: the checkpoint fingerprint compares the values' bits, and a resume with -0 refused its own 0.
+      if (first == 1 && text.find_first_of("123456789", 1) >= mantissa_end) text.erase(0, 1);
       return {};
     },
     "");
@@ -668,6 +678,7 @@ int run_profile_command(const render_options& o) {
   warn_unused_options(o, {kind});
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
+  warn_fine_depth(o, params.max_depth, {kind});
   std::optional<slow_phase_note> loading(std::in_place, params.notes, "loading " + o.scene + " ...");
   params.progress = false;  // (the timed stages must not share the machine with the bar; the notes stay)
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
@@ -728,6 +739,7 @@ int run_compare_command(const compare_options& o) {
   warn_unused_options(o.render, cp.samplers);
   scene_desc desc = load_scene_desc(o.render.scene);
   cp.render = resolve_params(o.render, desc, cp.samplers[0]);
+  warn_fine_depth(o.render, cp.render.max_depth, cp.samplers);
   cp.runs = o.runs;
   cp.scene_path = o.render.scene;
   cp.reference_path = o.render.reference;

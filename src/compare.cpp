@@ -172,7 +172,11 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
     // rise again in the pass after it, heavy-tailed as relMSE is), which is at the shortest run's last pass when a
     // signal stopped them sooner; at its mean time at equal spp (where its curve's last point, the mean of sums, can
     // differ from the sum of means in the last bit and miss it).
-    if (&st == &all[0]) st.time_to_target = data.equal_time ? std::min(t_cmp, st.seconds) : st.seconds;
+    // (A first pass that ended after the comparison time: at that pass, when its error was measured.)
+    if (&st == &all[0])
+      st.time_to_target = !data.equal_time    ? st.seconds
+                          : st.before_first_pass ? st.curve_seconds[0]
+                                                 : std::min(t_cmp, st.seconds);
     else st.time_to_target = time_to_reach(st.curve_seconds, st.curve_relmse, base.relmse);
   }
   return all;
@@ -309,14 +313,16 @@ void write_comparison(const compare_data& data, const compare_params& p, const i
 }
 
 // Creates the output directory when missing, with any missing parents (as mkdir -p); throws output_error when it
-// cannot be used. Returns whether it created it.
-static bool make_output_dir(const std::string& dir) {
+// cannot be used. Returns the folders it created, the deepest first.
+static std::vector<fs::path> make_output_dir(const std::string& dir) {
   std::error_code ec;
-  bool created = false;
-  if (!fs::exists(dir, ec)) {
-    created = fs::create_directories(dir, ec);
-    if (!created && !fs::is_directory(dir)) throw output_error("cannot create directory " + dir + ": " + ec.message());
+  std::vector<fs::path> created;
+  for (fs::path p = fs::path(dir).lexically_normal(); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    created.push_back(p);
+    if (p == p.parent_path()) break;
   }
+  if (!created.empty() && !fs::create_directories(dir, ec) && !fs::is_directory(dir))
+    throw output_error("cannot create directory " + dir + ": " + ec.message());
   if (!fs::is_directory(dir, ec)) throw output_error("cannot write into " + dir + ": not a directory");
   if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write into " + dir + ": directory is not writable");
   return created;
@@ -349,12 +355,12 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   loading.reset();
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", params.scene_path.c_str());
-  const bool created = make_output_dir(params.out_dir);
-  // Interrupted with nothing to report (as render, which then keeps the files already there): a folder this run
-  // created is removed again, since it stays empty.
+  const std::vector<fs::path> created = make_output_dir(params.out_dir);
+  // Interrupted with nothing to report (as render, which then keeps the files already there): the folders this run
+  // created are removed again, since they stay empty.
   auto nothing_written = [&](int status) {
     std::error_code ec;
-    if (created) fs::remove(params.out_dir, ec);  // (only if still empty)
+    for (const fs::path& p : created) fs::remove(p, ec);  // (only if still empty; the deepest first)
     return status;
   };
   if (int status = interrupted_before_render()) return nothing_written(status);

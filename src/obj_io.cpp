@@ -27,7 +27,8 @@ namespace bl {
 namespace fs = std::filesystem;
 
 const char* const degenerate_reason =
-    "zero area, or an area float maths cannot square: outside about 2e-23 to 9e18 square units; rescale the scene";
+    "zero area, or an area float maths cannot square: outside about 2e-23 to 9e18 square units; rescale the scene, "
+    "or move it near the origin where float corners far from it collapse";
 
 // How triangle (a, b, c) fares in float maths: kept (|cross|^2 a positive finite float), flat (cross exactly 0: its
 // corners on one line) or unusable (an area float cannot square: underflow, overflow).

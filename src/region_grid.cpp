@@ -4,6 +4,7 @@
 #include "rng.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <queue>
 #include <unordered_set>
 
@@ -126,10 +127,12 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
   vec3f ext = extent(b);
   float longest = std::max(max_component(ext), 1e-20f);
   float shortest = std::min(ext.x, std::min(ext.y, ext.z));
-  // A flat scene (one plane, up to rounding) has no shortest extent: use a thousandth of the longest one instead. A
-  // scene that is only thin for its size (a room on a ground plane reaching 1e5) keeps its own: with a thousandth of
-  // the ground's side the room fitted in a few cells (max_cells_per_axis still bounds the count).
-  if (!(shortest > 1e-7f * longest)) shortest = 1e-3f * longest;
+  // A flat scene (one plane, up to a few ulps of its coordinates) has no shortest extent: use a thousandth of the
+  // longest one instead. A scene that is only thin for its size (a room on a ground plane reaching 1e5) keeps its own:
+  // with a thousandth of the ground's side the room fitted in a few cells (max_cells_per_axis still bounds the count,
+  // so cells shrink less than the extent from about 6e-5 of the longest side down).
+  const float coords = std::max(max_abs_component(b.lo), max_abs_component(b.hi));
+  if (!(shortest > 4 * FLT_EPSILON * coords)) shortest = 1e-3f * longest;
   float cell = shortest / float(std::max(1, params.grid));
   cell = std::max(cell, longest / float(max_cells_per_axis - 1));
   g.origin = b.lo;

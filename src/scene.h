@@ -81,7 +81,7 @@ inline vec3f offset_ray_origin(const scene_data& scene, int tri, vec3f p, vec3f 
   return offset_along(p, n, d, ray_epsilon(scene, tri, p));
 }
 // The least offset off a surface: 1/20 of ray_epsilon (8 to 17 float ulps of p's largest coordinate, and 4 to 8 of
-// its triangle's: what the hit point's rounding needs; a point near the origin interpolated from corners of size 1
+// its triangle's tri_extent: what the hit point's rounding needs; a point near the origin interpolated from corners of size 1
 // errs by more than half an ulp of 1, and a floor of 0.4 ulps let a tilted tile shadow itself under a low sun). Rays start this far off (shadow rays) or count hits from this height on (continuation
 // rays), so that a lamp or an occluder closer to a surface than ray_epsilon is not stepped over.
 inline float min_ray_epsilon(const scene_data& scene, int tri, vec3f p) { return 0.05f * ray_epsilon(scene, tri, p); }

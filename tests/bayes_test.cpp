@@ -164,7 +164,7 @@ shade_point pixel_point(const test_scene& t, int x, int y) {
   vec3f dir = camera_ray_dir(t.in.camera, float(x) + 0.5f, float(y) + 0.5f);
   hit_info h = intersect(t.bvh, t.in.camera.eye, dir);
   REQUIRE(h.tri != invalid_id);
-  surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, dir);
+  surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, h.p, dir);
   return shade_point{sp.p, sp.ng, 0.5f, y * t.in.camera.width + x, 1};
 }
 

@@ -659,11 +659,11 @@ TEST_CASE("a quiet render interrupted while writing its outputs says what it wro
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
   int status = shell_status(std::string("( timeout -k 10 20 ") + BAYESLIGHT_BINARY + " render " + s.json +
                             " --quiet --spp 2 -o " + (s.dir / "a.pfm") + " -o " + fifo + " -o " + (s.dir / "b.png") +
-                            " 2>" + (s.dir / "err.txt") + " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo $? )");
+                            " 2>" + (s.dir / "err.txt") + " & pid=$!; sleep 2; kill -INT $pid; wait $pid; echo $? )");
   std::string err = read_text(s.dir / "err.txt");
   INFO(err);
   CHECK(status == 130);
-  CHECK(err.find("rendered 2 spp") != std::string::npos);
+  CHECK(err.find("rendered 2 spp") != std::string::npos);  // (2 spp of 16x12 pixels end long before the signal)
   CHECK(err.find("-> " + (s.dir / "a.pfm") + ", " + (s.dir / "b.png")) != std::string::npos);
 }
 
@@ -827,6 +827,12 @@ TEST_CASE("real-valued options take plain decimals with a fraction and exponent"
     INFO(v << "\n" << r.output);
     CHECK(r.status == 0);
   }
+  // -0 is 0: a checkpoint made with 0 resumes with -0 (its fingerprint compares the value's bits; a review).
+  const std::string base = "render " + s.json + " --quiet -o " + (s.dir / "b.pfm");
+  REQUIRE(run_bayeslight(base + " --spp 2 --pass-weighting 0 --checkpoint " + (s.dir / "c.bin")).status == 0);
+  auto r = run_bayeslight(base + " --spp 4 --pass-weighting -0.0 --resume " + (s.dir / "c.bin"));
+  INFO(r.output);
+  CHECK(r.status == 0);
 }
 
 TEST_CASE("a fine depth past the render's max depth is named in a warning", "[cli]") {
@@ -846,6 +852,12 @@ TEST_CASE("a fine depth past the render's max depth is named in a warning", "[cl
   INFO(r.output);
   CHECK(r.output.find("--fine-depth (bound, donikian and bayes only)") != std::string::npos);
   CHECK(r.output.find("above the max depth") == std::string::npos);
+  // compare: whichever sampler of its list has regions (it checked the first one only).
+  r = run_bayeslight("compare " + s.json + " --quiet --spp 1 --samplers uniform,bayes --max-depth 2 --fine-depth 5 "
+                     "--reference " + (s.dir / "a.pfm") + " --out " + (s.dir / "cmp"));
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("--fine-depth 5 is above the max depth 2") != std::string::npos);
 }
 
 TEST_CASE("help that cannot be written is a failure", "[cli]") {

@@ -342,13 +342,13 @@ TEST_CASE("compare interrupted before any pass keeps an earlier comparison's fil
   for (auto& e : std::filesystem::directory_iterator(out)) after[e.path().string()] = slurp(e.path().string());
   CHECK(after == before);
   // A folder the interrupted comparison created is not left behind, empty (a review).
-  const std::string fresh = s.dir / "fresh";
+  const std::string fresh = s.dir / "fresh/a/b";
   st = std::system(("timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " compare " + s.json +
                     " --reference " + s.ref + " --samplers bayes --out " + fresh +
                     " --threads 1 --quiet --spp 2 --bayes-oracle 100000000 2>/dev/null").c_str());
   CHECK(WIFEXITED(st));
   CHECK(WEXITSTATUS(st) == 130);
-  CHECK(!std::filesystem::exists(fresh));
+  CHECK(!std::filesystem::exists(s.dir / "fresh"));
   // Cut short after uniform's passes, in bayes's warm-up: the summary covers uniform, and the earlier bayes images
   // (which it does not describe) are gone.
   REQUIRE(std::filesystem::exists(out + "/bayes.exr"));
@@ -603,6 +603,11 @@ TEST_CASE("an equal-time comparison shorter than a first pass gives no speed-up 
   p.samplers = {sampler_kind::uniform, sampler_kind::power, sampler_kind::bound};
   p.render.time_budget = 0.001;
   CHECK(comparison_summary(d, p).find("ends before the first pass of power") != std::string::npos);
+  // The first sampler's own first pass ending after the comparison time: it reached its error there, not sooner.
+  d.time_budget = 0.0005;
+  st = comparison_stats(d);
+  CHECK(st[0].before_first_pass);
+  CHECK(st[0].time_to_target == Approx(0.00084));
 }
 
 TEST_CASE("the plot writer escapes labels and draws one path per series", "[compare]") {

@@ -82,7 +82,7 @@ std::vector<shade_point> shading_points(const test_scene& t, int count, uint64_t
     }
     hit_info h = intersect(t.bvh, org, dir);
     if (h.tri == invalid_id) continue;
-    surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, dir);
+    surface_point sp = eval_surface(t.scene, h.tri, h.b1, h.b2, h.p, dir);
     // Pixels cycle through the image (samplers that learn per pixel index their tables with them). The wall's
     // Phong lobe makes some points glossy (bayes weighs their clusters with the lobe, members one by one).
     int pixel = int(out.size()) % (t.in.camera.width * t.in.camera.height);
@@ -553,6 +553,9 @@ TEST_CASE("fine cells follow the shortest extent of a thin scene, and a thousand
   CHECK(small.grid.cell[0] == Approx(3.0 / 64).epsilon(1e-5));
   region_state flat = make_region_state({{-5e4f, 0, -5e4f}, {5e4f, 0, 5e4f}}, tree, false, rp);
   CHECK(flat.grid.cell[0] == Approx(1e5 * 1e-3 / 64).epsilon(1e-5));
+  // A plane at y = 1000 whose corners' y differ by an ulp (6e-5) is flat too, not a scene 6e-5 thick.
+  region_state jitter = make_region_state({{0, 1000, 0}, {10, 1000.00006f, 10}}, tree, false, rp);
+  CHECK(jitter.grid.cell[0] == Approx(10 * 1e-3 / 64).epsilon(1e-4));
 }
 
 TEST_CASE("fine regions over the pair budget are not created, and their keys are not tried again", "[samplers][regions]") {

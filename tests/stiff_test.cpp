@@ -110,7 +110,7 @@ void check_bayes_state(const test_scene& b, int depth, const bayes_params& param
       vec3f dir = camera_ray_dir(in.camera, float(x) + 0.5f, float(y) + 0.5f);
       hit_info h = intersect(b.bvh, in.camera.eye, dir);
       if (h.tri == invalid_id) continue;
-      surface_point sp2 = eval_surface(b.scene, h.tri, h.b1, h.b2, dir);
+      surface_point sp2 = eval_surface(b.scene, h.tri, h.b1, h.b2, h.p, dir);
       s.prepare(*ctx, shade_point{sp2.p, sp2.ng, 0.5f, 0, 1});
       for (int j = 0; j <= ctx->count; j++)
         if (!std::isfinite(ctx->cdf[j])) nonfinite++;
