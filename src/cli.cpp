@@ -110,10 +110,14 @@ void check_output_path(const std::string& path) {
     fs::path target = fs::path(output_target(path)).parent_path();  // where it points
     if (!target.empty()) dir = target;
   }
-  if (!fs::is_directory(dir, ec))
+  if (!fs::is_directory(dir, ec)) {
+    // The nearest folder on the way that exists: a file there is the problem, not a missing directory.
+    fs::path up = dir;
+    while (up.has_parent_path() && up != up.parent_path() && !fs::exists(up, ec)) up = up.parent_path();
     throw output_error("cannot write " + path + ": " +
-                       (fs::exists(dir, ec) ? dir.string() + " is not a directory"
-                                            : "directory " + dir.string() + " does not exist"));
+                       (fs::exists(up, ec) && !fs::is_directory(up, ec) ? up.string() + " is not a directory"
+                                                                        : "directory " + dir.string() + " does not exist"));
+  }
   if (access(dir.c_str(), W_OK) != 0) throw output_error("cannot write " + path + ": directory " + dir.string() + " is not writable");
 }
 

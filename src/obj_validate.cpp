@@ -432,8 +432,8 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     // map_Kd and map_d in any case (map_kd, MAP_D), as Assimp and three.js read them; other keywords as written.
     const std::string lower_k = ascii_lower(k);
     if (lower_k == "map_kd" || lower_k == "map_d") k = lower_k == "map_kd" ? "map_Kd" : "map_d";
-    bool texture =
-        k.compare(0, 4, "map_") == 0 || k == "bump" || k == "disp" || k == "decal" || k == "refl" || k == "norm";
+    bool texture = lower_k.compare(0, 4, "map_") == 0 || k == "bump" || k == "disp" || k == "decal" || k == "refl" ||
+                   k == "norm";
     if (k == "newmtl" || texture) {
       if (commented) tokenize(line, pos, named, true);
       else named = t;

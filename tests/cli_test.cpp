@@ -872,6 +872,10 @@ TEST_CASE("an output under a file names the file as not a directory", "[cli]") {
   INFO(r.output);
   CHECK(r.status == 1);
   CHECK(r.output.find("afile is not a directory") != std::string::npos);
+  r = run_bayeslight("render " + s.json + " --spp 1 --quiet -o " + (s.dir / "afile/sub/x.pfm"));  // deeper too
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("afile is not a directory") != std::string::npos);
 }
 
 TEST_CASE("an output through a dangling symlink is the file the link names", "[cli]") {
