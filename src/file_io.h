@@ -10,6 +10,9 @@
 
 namespace bl {
 
+// The extension of path's file name in ASCII lower case, with its dot (".exr"); "" for none (".exr" alone, "dir.exr/").
+std::string lower_extension(const std::string& path);
+
 // Throws input_error naming path unless it is an existing regular file (not a FIFO, device or directory).
 void require_regular_file(const std::string& path);
 // The whole content of a file; throws input_error(path, reason) when it cannot be opened or read.

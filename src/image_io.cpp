@@ -24,15 +24,10 @@ static constexpr int64_t max_image_side = int64_t(1) << 20;
 static constexpr int64_t max_image_pixels = int64_t(1) << 28;
 
 image_format image_format_of(const std::string& path) {
-  size_t slash = path.rfind('/');
-  size_t start = slash == std::string::npos ? 0 : slash + 1;
-  size_t dot = path.rfind('.');
-  if (dot == std::string::npos || dot <= start) return image_format::unknown;  // "x/.exr" has no extension
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == "exr") return image_format::exr;
-  if (ext == "pfm") return image_format::pfm;
-  if (ext == "png") return image_format::png;
+  const std::string ext = lower_extension(path);  // ("x/.exr" and "x.exr/" have none)
+  if (ext == ".exr") return image_format::exr;
+  if (ext == ".pfm") return image_format::pfm;
+  if (ext == ".png") return image_format::png;
   return image_format::unknown;
 }
 

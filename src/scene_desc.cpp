@@ -193,11 +193,6 @@ void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
   }
 }
 
-std::string lower_extension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
 
 }  // namespace
 

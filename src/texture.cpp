@@ -47,9 +47,7 @@ static const char* refused_format(const std::string& b) {
 static bool accepted_format(const std::string& b, const std::string& path) {
   auto starts = [&](const char* magic, size_t n) { return b.size() >= n && std::memcmp(b.data(), magic, n) == 0; };
   if (starts("\x89PNG\r\n\x1a\n", 8) || starts("\xFF\xD8\xFF", 3) || starts("BM", 2)) return true;
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = char(std::tolower((unsigned char)c));
-  return ext == ".tga";
+  return lower_extension(path) == ".tga";
 }
 
 // Little-endian integer of n bytes at offset off of b (0 past the end).
