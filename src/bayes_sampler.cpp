@@ -526,7 +526,11 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
 void bayes_sampler::begin_frame(double decay) {
   if (decay >= 1) return;
   decay_stats(stats, decay);
-  refresh_weights(stats, &regions.pair_parent, params);
+  refresh_all_weights();
+}
+
+void bayes_sampler::refresh_all_weights() {
+  refresh_weights(stats, params.hierarchy > 0 && params.prior ? &regions.pair_parent : nullptr, params);
   refresh_groups(nullptr);
 }
 
@@ -627,8 +631,7 @@ void bayes_sampler::rebuild_posterior() {
   stats.mu0.assign(n, 0.0f);
   stats.w.assign(n + 4, 0.0f);
   add_pairs(0);
-  refresh_weights(stats, &regions.pair_parent, params);
-  refresh_groups(nullptr);
+  refresh_all_weights();
 }
 
 void bayes_sampler::learn(std::vector<row_state>& rows) {

@@ -127,6 +127,9 @@ struct bayes_sampler {
   void refold(const std::vector<int>& touched, size_t old_pairs);
   // Recomputes every derived column (prior means, coefficients, weights) from the regions and statistics.
   void rebuild_posterior();
+  // Folds every pair's weight afresh, with the parents refold uses (none without the hierarchy: a fine pair's control
+  // variate then never takes its coarse parent's mean either), and the clusters' sums.
+  void refresh_all_weights();
   // Members: recomputes the cluster columns (gw, gw_cv, gcv) of the clusters of the given pairs (nullptr: all) from
   // their members' weights. Each cluster's sum runs over its members in order: a function of the weights only.
   // Given pairs must be listed once each and flagged in stats.scratch.dirty (refold does both).

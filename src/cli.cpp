@@ -355,6 +355,14 @@ int run_render(const render_options& o) {
                      : reference_key == 0 ? "measured against a reference, and this render has none"
                                           : "measured against another reference");
       }
+      // An adaptive sampler's passes after a truncated one learn from other sample counts (and weigh theirs
+      // otherwise) than one render's: still a correct image, but not the bytes the README promises at pass ends.
+      if (sampler_adapts(s) && !ends_scheduled_pass(r.spp, int64_t(r.width) * r.height) &&
+          (params.time_budget > 0 || params.spp > r.spp))
+        std::fprintf(stderr,
+                     "%s: warning: its %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 ... do): the "
+                     "continued image is correct, but not bit-identical to one render of the final spp\n",
+                     o.resume.c_str(), r.spp);
       // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
       if (params.time_budget <= 0 && r.spp > params.spp)
         throw usage_error((o.spp > 0 ? "--spp " + std::to_string(params.spp)

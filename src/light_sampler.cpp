@@ -151,8 +151,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.regions = make_regions(params, in, tree);
       s.reserve_growth();
       s.add_pairs(0);
-      refresh_weights(s.stats, &s.regions.pair_parent, s.params);
-      s.refresh_groups(nullptr);
+      s.refresh_all_weights();
       return s;
     }
     default: break;

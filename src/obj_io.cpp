@@ -16,6 +16,7 @@
 #include <array>
 #include <climits>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -101,6 +102,27 @@ static std::vector<size_t> compact_refs(std::vector<int>& refs, size_t count) {
   for (int& r : refs)
     if (r >= 0) r = remap[size_t(r)];
   return kept;
+}
+
+// Largest corner coordinate accepted: Embree refuses ray origins beyond about 1.8e18, and squared distances in float
+// overflow from about 1.8e19 (a grid or light bounds over a scene spanning 3e38 would be NaN).
+constexpr float max_corner_coordinate = 1e18f;
+
+// Refuses a mesh with a used corner beyond max_corner_coordinate (only slivers or far-off small triangles get there:
+// larger areas are degenerate in float already), naming the first such 'v' line by its number.
+static void check_corner_range(const std::string& path, const std::vector<vec3f>& positions,
+                               const std::vector<int>& refs) {
+  size_t first = SIZE_MAX;
+  for (int r : refs)
+    if (!(max_abs_component(positions[size_t(r)]) <= max_corner_coordinate)) first = std::min(first, size_t(r));
+  if (first == SIZE_MAX) return;
+  vec3f v = positions[first];
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "vertex %zu (counting 'v' lines from 1) at (%.3g, %.3g, %.3g)", first + 1,
+                double(v.x), double(v.y), double(v.z));
+  throw input_error(path, std::string(buf) +
+                              " lies beyond 1e18 of the origin, where float squared distances and ray origins "
+                              "overflow: rescale the scene or remove the far-off geometry");
 }
 
 // Emitted power (luminance of Ke times area times pi) above which light sums and importances could overflow float.
@@ -292,6 +314,8 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
                                             ? " (" + std::to_string(mesh.dropped_degenerate) +
                                                   " degenerate dropped: " + degenerate_reason + ")"
                                             : std::string()));
+
+  check_corner_range(path, clean.positions, mesh.tri_positions);
 
   // Compact each vertex array to the referenced elements, keeping file order.
   for (size_t i : compact_refs(mesh.tri_positions, clean.positions.size())) mesh.positions.push_back(position(i));

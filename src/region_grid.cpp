@@ -113,7 +113,11 @@ int append_region(region_state& s, uint64_t key, const std::vector<int>* cut, co
 }  // namespace
 
 bbox3f padded(const bbox3f& b) {
-  vec3f m = extent(b) * 1e-3f;
+  // A thousandth of the box, and at least a few ulps of its coordinates: a point's cell is found by a float division
+  // that may round it across a face of a box far from the origin by about an ulp.
+  const float ulps = 4 * FLT_EPSILON * std::max(max_abs_component(b.lo), max_abs_component(b.hi));
+  vec3f e = extent(b) * 1e-3f;
+  vec3f m = {std::max(e.x, ulps), std::max(e.y, ulps), std::max(e.z, ulps)};
   return {b.lo - m, b.hi + m};
 }
 
@@ -135,13 +139,21 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
   if (!(shortest > 4 * FLT_EPSILON * coords)) shortest = 1e-3f * longest;
   float cell = shortest / float(std::max(1, params.grid));
   cell = std::max(cell, longest / float(max_cells_per_axis - 1));
+  // Cells of at least a few ulps of the coordinates (a 1 cm thick scene 10 m wide at x = 1e4 would have cells below
+  // one: boxes of zero size whose bounds are infinite).
+  cell = std::max(cell, 4 * FLT_EPSILON * coords);
   g.origin = b.lo;
   g.cell[0] = cell;
   g.cell[1] = cell * 8;
   g.cell[2] = longest * 1.001f;
   for (int l = 0; l < region_levels; l++)
     for (int a = 0; a < 3; a++)
-      g.dims[l][a] = l == 2 ? 1 : std::max(1, std::min(max_cells_per_axis, int(std::ceil(ext[a] / g.cell[l])) + 1));
+      if (l == 2) g.dims[l][a] = 1;
+      else {
+        // (clamped before the conversion: no float-to-int of a value beyond int, or of NaN)
+        double cells = double(std::ceil(ext[a] / g.cell[l])) + 1;
+        g.dims[l][a] = cells < double(max_cells_per_axis) ? std::max(1, int(cells)) : max_cells_per_axis;
+      }
   std::vector<int> all;
   int leaves = (node_count(tree) + 1) / 2;
   if (node_count(tree) > 0 && leaves <= std::min(params.max_cut, params.shared_cut_lights)) {

@@ -292,6 +292,12 @@ int pass_size(int pass, int done, int64_t pixels) {
   return std::min(cap, std::max(1, done / 4));
 }
 
+bool ends_scheduled_pass(int spp, int64_t pixels) {
+  int64_t done = 0;
+  for (int pass = 0; done < spp; pass++) done += pass_size(pass, int(done), pixels);
+  return done == spp;
+}
+
 bool sampler_adapts(const light_sampler& s) {
   return std::visit([](const auto& x) { return adapts(x); }, s);
 }

@@ -83,6 +83,9 @@ struct render_result {
 // Samples per pixel of pass `pass` given `done` samples before it (before truncation to the target), for an image
 // of `pixels` pixels.
 int pass_size(int pass, int done, int64_t pixels);
+// Whether `spp` ends a pass of the untruncated schedule (pass_size from 0): a render stopped there and continued
+// takes the same passes as one render of more spp.
+bool ends_scheduled_pass(int spp, int64_t pixels);
 // Weight of the samples of a pass that starts after `done` spp: (done + 1) / (done + 1 + s), 1 for s = 0.
 double pass_weight(int done, double s);
 // Whether the sampler's passes are weighted by pass_weight (an adaptive sampler that still learns).

@@ -1400,3 +1400,18 @@ TEST_CASE("dead ends in concave polygons of many corners load as exact triangula
   CHECK(area == Approx(shoelace(base)).epsilon(1e-6));
   CHECK(shoelace(o) == shoelace(base));  // (dead ends add no area)
 }
+
+TEST_CASE("corners beyond 1e18 of the origin are refused, naming the vertex", "[obj]") {
+  // Two slivers out to +-3e38 passed every per-triangle check; the scene's extent was then infinite and the region
+  // grid NaN (a review). Unused far-off vertices stay harmless.
+  temp_dir dir;
+  auto far = dir.write("far.obj",
+                       "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 3e38 0 0\nv 3e38 1e-30 0\nv -3e38 0 0\nv -3e38 0 1e-30\n"
+                       "f 1 2 3\nf 1 4 5\nf 1 6 7\n");
+  std::string e = load_error(far);
+  CHECK_THAT(e, Catch::Contains("far.obj") && Catch::Contains("vertex 4 ") && Catch::Contains("beyond 1e18"));
+  auto unused = dir.write("unused.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 3e38 0 0\nf 1 2 3\n");
+  CHECK(load_error(unused).empty());
+  auto edge = dir.write("edge.obj", "v 1e18 0 0\nv 1e18 1 0\nv 1e18 0 1\nf 1 2 3\n");  // at the limit: kept
+  CHECK(load_error(edge).empty());
+}
