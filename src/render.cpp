@@ -274,7 +274,13 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
       rec.error = compute_error(mean.pixels.data(), params.reference->pixels.data(), mean.pixels.size());
     }
     result.log.push_back(rec);
-    if (after_pass) after_pass();
+    if (after_pass) {
+      // What the caller does between passes (a checkpoint: seconds for a large render) is render time too: the next
+      // pass's seconds, the --time budget and the summary count it (the error computation above they do not).
+      auto ta = clock_type::now();
+      after_pass();
+      result.seconds += seconds_since(ta);
+    }
   }
 }
 

@@ -13,6 +13,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <chrono>
+#include <thread>
+
 #include <cmath>
 #include <csignal>
 #include <memory>
@@ -126,6 +129,32 @@ TEST_CASE("passes of a tiny image grow to 65536 samples, so their records stay f
   render_result r = render(b->scene, b->bvh, b->lights, p);
   CHECK(r.spp == 1 << 20);
   CHECK(r.passes < 80);  // about 67 (16,400 in 64-spp passes)
+}
+
+TEST_CASE("time spent between passes (checkpoints) counts in the render's seconds and its time budget", "[passes]") {
+  // A 4096^2 render's checkpoints took 30 s of a 42 s run whose summary and log said 9.1 s, and a --time budget
+  // ignored them (a review). Each call between passes here takes at least 50 ms (a sleep: a lower bound, not a timing).
+  auto b = boxed_lamp_scene();
+  render_params p = small_params(sampler_kind::uniform, 6, 0);
+  int calls = 0;
+  p.on_pass = [&](const render_result&, const light_sampler&, bool last) {
+    if (last) return;  // (the last one comes with the outputs, after the render)
+    calls++;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  };
+  render_result r = render(b->scene, b->bvh, b->lights, p);
+  REQUIRE(calls == 6);
+  CHECK(r.seconds >= 0.3);
+  REQUIRE(r.log.size() == 6);
+  CHECK(r.log[5].seconds - r.log[0].seconds >= 0.25);  // the calls after passes 1-5 fall within the log's times
+  // A budget of 0.2 s is spent by the calls after four passes at the latest, whatever the passes take.
+  render_params t = p;
+  t.spp = 0;
+  t.time_budget = 0.2;
+  calls = 0;
+  render_result timed = render(b->scene, b->bvh, b->lights, t);
+  CHECK(timed.passes <= 4);
+  CHECK(calls == timed.passes);
 }
 
 TEST_CASE("an oracle interrupted while it learns leaves no frozen model behind", "[passes]") {
