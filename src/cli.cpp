@@ -133,10 +133,28 @@ std::string unused_because(const std::string& name, const std::string& group, sa
                            const render_options& o) {
   const bool bayes = kind == sampler_kind::bayes, bound = kind == sampler_kind::bound;
   const bool adaptive = bayes || kind == sampler_kind::donikian;
-  if (name == "--cut-members" || group == bayes_group) return bayes ? "" : "bayes only";
+  if (name == "--cut-members" || group == bayes_group) {
+    if (!bayes) return "bayes only";
+    // Within bayes, the options its other options leave without effect.
+    const bool naive = !o.bayes.prior, point = o.bayes_prior == "point", mean = o.bayes_pmf == "mean";
+    if (naive && (name == "--bayes-a0" || name == "--bayes-b0" || name == "--bayes-kappa0" ||
+                  name == "--bayes-alpha0" || name == "--bayes-c" || name == "--bayes-no-mean-hierarchy"))
+      return "no prior with --bayes-naive";
+    if (point && (name == "--bayes-no-orientation" || name == "--bayes-no-bsdf-factor" || name == "--bayes-no-cv" ||
+                  name == "--bayes-cv-min-visible" || name == "--bayes-no-mean-hierarchy"))
+      return "region prior only, not with --bayes-prior point";
+    if (mean && (name == "--bayes-no-cv" || name == "--bayes-cv-min-visible"))
+      return "control variates need --bayes-pmf second-moment";
+    if (!o.bayes.control_variate && name == "--bayes-cv-min-visible") return "no control variates with --bayes-no-cv";
+    if (!(o.bayes.hierarchy > 0) && name == "--bayes-no-mean-hierarchy") return "no hierarchy with --bayes-hierarchy 0";
+    return "";
+  }
   // (donikian's deeper vertices use bound's regions, and its first-hit cut their --max-cut)
   if (group == region_group) return bound || adaptive ? "" : "bound, donikian and bayes only";
-  if (name == "--pass-weighting") return adaptive ? "" : "bayes and donikian only";
+  if (name == "--pass-weighting") {
+    if (!adaptive) return "bayes and donikian only";
+    return bayes && o.bayes.oracle_spp > 0 ? "a frozen --bayes-oracle model does not adapt" : "";
+  }
   if (name == "--frame-decay") return o.frames > 1 && adaptive ? "" : "with --frames and bayes or donikian only";
   if (name == "--checkpoint-every") return o.checkpoint.empty() ? "with --checkpoint only" : "";
   return "";
@@ -234,6 +252,23 @@ void warn_fine_depth(const render_options& o, int max_depth, const std::vector<s
   if (given && used && o.regions.fine_depth > max_depth)
     std::fprintf(stderr, "bayeslight: warning: --fine-depth %d is above the max depth %d: depths past %d change nothing\n",
                  o.regions.fine_depth, max_depth, max_depth);
+  // donikian's regions are bound's, for the vertices past the first; its first hit reads only --max-cut and
+  // --cut-coherence (its cut over the scene). Named when no sampler of `kinds` reads them at this max depth.
+  if (max_depth > 1 || std::find(kinds.begin(), kinds.end(), sampler_kind::donikian) == kinds.end()) return;
+  std::string unused;
+  for (const auto& [name, group] : o.given) {
+    if (group != region_group || name == "--max-cut" || name == "--cut-coherence" ||
+        !unused_because(name, group, sampler_kind::donikian, o).empty())  // (warned about already)
+      continue;
+    bool read = false;
+    for (sampler_kind k : kinds) read |= k != sampler_kind::donikian && unused_because(name, group, k, o).empty();
+    if (!read) unused += (unused.empty() ? "" : ", ") + name;
+  }
+  if (!unused.empty())
+    std::fprintf(stderr,
+                 "bayeslight: warning: options that change nothing in this run are ignored: %s (donikian's regions "
+                 "serve the vertices past the first, and the max depth is 1)\n",
+                 unused.c_str());
 }
 
 int run_render(const render_options& o) {
@@ -553,11 +588,11 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "bayes: clusters of a region's cut are refined into at most this many members in all, each learned "
                 "apart and chosen inside its cluster (default 128 with --max-depth 1, else 0; at most 1024). Any count "
                 "also lets a fine cluster learn from the coarse cluster holding it (0: only from one of the same "
-                "node), so a count that refines nothing (at most the cut size) still differs a little from 0")
+                "node), so a count that refines nothing (at most the cut size) can still differ a little from 0")
       ->check(CLI::Range(0, 1024))->group(grp);
   r->add_option("--shared-cut-lights", o.regions.shared_cut_lights,
-                "Scenes with at most this many lights give every region a cut of all lights, no clustering (default 16; "
-                "0: always clustered cuts)")
+                "Scenes with at most this many lights, and at most --max-cut, give every region a cut of all lights, "
+                "no clustering (default 16; 0: always clustered cuts)")
       ->check(CLI::Range(0, 1 << 30))->group(grp);
   r->add_option("--fine-depth", o.regions.fine_depth,
                 "Path vertices up to this depth use fine regions, deeper ones coarse regions (default 1)")
@@ -592,16 +627,21 @@ void add_render_options(CLI::App* r, render_options& o) {
                        "Ablation: a glossy point weighs clusters as a diffuse one would (no Phong lobe in its factor)")
       ->group(bg);
   r->add_flag_callback("--bayes-no-regression", [&o] { o.bayes.distance_regression = false; },
-                       "Ablation: no 1/d^2 distance regression (z = Y)")->group(bg);
+                       "Ablation: no 1/d^2 distance regression (z = Y): near lamps' spread then starves what a region "
+                       "rarely sees lit (the living room's sun through its windows): unbiased, but heavy-tailed images, "
+                       "mostly too dark at practical spp")->group(bg);
   r->add_flag_callback("--bayes-naive", [&o] { o.bayes.prior = false; },
                        "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method: clusters it starves are "
                        "never sampled again, so its images are biased in practice)")->group(bg);
   r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the prior-only (bound) PMF, in [0, 1] (default 0)")
       ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
   // (At most 1e6 apart from the counts: the posterior mean of 1 - p0 stays far above float's least number.)
-  r->add_option("--bayes-a0", o.bayes.a0, "Beta prior of p0: pseudo-count of zero samples (1e-6 to 1e6, default 0.3)")
+  r->add_option("--bayes-a0", o.bayes.a0,
+                "Beta prior of p0: pseudo-count of zero samples (1e-6 to 1e6, default 0.3; a large a0, or a tiny b0, "
+                "starves clusters before their first lit sample: heavy-tailed images, mostly too dark)")
       ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
-  r->add_option("--bayes-b0", o.bayes.b0, "Beta prior of p0: pseudo-count of non-zero samples (1e-6 to 1e6, default 0.03)")
+  r->add_option("--bayes-b0", o.bayes.b0,
+                "Beta prior of p0: pseudo-count of non-zero samples (1e-6 to 1e6, default 0.03)")
       ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
   // (kappa0 and c at most 1e6: beyond, kappa0 n1 and c mu0^2 of bright lights overflow, and every weight met the
   // ceiling of the fold, max_pair_weight, so that the PMF ignored the bound and p0 alike.)
