@@ -434,6 +434,11 @@ int run_render(const render_options& o) {
   output_failures failures;  // every output is tried (and every frame rendered) whatever failed before it
   render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
     std::vector<std::string> files;
+    // (A 4096^2 EXR takes seconds to compress and write after the bar has reached its end.)
+    std::optional<slow_phase_note> writing;
+    if (!outputs.empty() && result.spp > 0)
+      writing.emplace(params.notes, "writing " + frame_path(outputs[0], frame, animated) +
+                                        (outputs.size() > 1 ? " and the other outputs ..." : " ..."));
     if (result.spp > 0) {
       image_data img = film_image(result);
       for (const std::string& out : outputs) {
@@ -441,6 +446,7 @@ int run_render(const render_options& o) {
         if (failures.attempt([&] { write_image(f, img); })) files.push_back(f);
       }
     }
+    writing.reset();
     // (Nor a log without a pass: a file already there is kept, as the image is.)
     if (!o.log.empty() && result.passes > 0)
       failures.attempt(

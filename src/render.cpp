@@ -175,6 +175,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
                  const std::function<void()>& after_pass = {}) {
   int w = params.width, h = params.height;
   size_t n = size_t(w) * size_t(h) * 3;
+  // (Large images: zeroing the film and per-row buffers touches hundreds of MB, seconds before the bar appears.)
+  std::optional<slow_phase_note> preparing(std::in_place, params.notes, "preparing the image's buffers ...");
   if (result.film.size() != n) {
     result.film.assign(n, 0.0);
     result.film_weight = 0;
@@ -201,6 +203,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   progress.time_budget = params.time_budget;
   progress.seconds_before = result.seconds;
   progress.rows = h;
+  preparing.reset();
   progress_bar bar(progress, params.progress);
 
   const int target = params.time_budget > 0 ? INT_MAX : params.spp;
