@@ -241,6 +241,18 @@ void warn_unused_options(const render_options& o, const std::vector<sampler_kind
   if (!unused.empty())
     std::fprintf(stderr, "bayeslight: warning: options that change nothing in this run are ignored: %s\n",
                  unused.c_str());
+  // A budget near its maximum lets a fine grid's regions take tens of GB (a review: 10 GB at 160x120 with --grid
+  // 100000 --region-min-samples 1): said before the render, with what it can cost. About 130 bytes per pair (the
+  // statistics and weight columns, the cut entries), fine and coarse pairs up to twice the budget.
+  constexpr double bytes_per_pair = 130, warn_bytes = 4.0 * (1 << 30);
+  bool regions = false;
+  for (sampler_kind k : kinds) regions |= unused_because("--region-budget", region_group, k, o).empty();
+  const double most = 2.0 * double(o.regions.max_pairs) * bytes_per_pair;
+  if (regions && o.regions.max_pairs > 0 && most > warn_bytes)
+    std::fprintf(stderr,
+                 "bayeslight: warning: --region-budget %lld lets the regions' statistics grow to about %.0f GB where "
+                 "the samples reach that many cells (a fine --grid, a small --region-min-samples)\n",
+                 (long long)o.regions.max_pairs, most / (1 << 30));
 }
 
 // Fine regions at depths the paths never reach change nothing either: named in a warning when a sampler of `kinds`

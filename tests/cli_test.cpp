@@ -855,6 +855,20 @@ TEST_CASE("bayes options that its other options leave without effect are named i
   }
 }
 
+TEST_CASE("a region budget that allows gigabytes of statistics is named in a warning", "[cli]") {
+  tiny_scene s;
+  const std::string base = "render " + s.json + " --spp 1 --quiet -o " + (s.dir / "a.pfm");
+  auto r = run_bayeslight(base + " --region-budget 536870912");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("--region-budget 536870912 lets the regions' statistics grow to about 130 GB") != std::string::npos);
+  for (const char* options : {"--region-budget 1000000", "--sampler uniform --region-budget 536870912"}) {
+    r = run_bayeslight(base + " " + options);
+    INFO(options << "\n" << r.output);
+    CHECK(r.output.find("lets the regions' statistics grow") == std::string::npos);
+  }
+}
+
 TEST_CASE("real-valued options take plain decimals with a fraction and exponent", "[cli]") {
   tiny_scene s;
   for (const char* v : {"0.5", ".5", "5.", "5e-1", "0.05E+1", "-0"}) {
