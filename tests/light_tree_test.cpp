@@ -577,6 +577,37 @@ TEST_CASE("a light cut partitions the lights that can reach its box", "[light_tr
   }
 }
 
+TEST_CASE("members refined under a smaller limit are the same, or reach that limit", "[light_tree]") {
+  // add_regions refines a region's members only up to one more than the pairs left in the budget: exact only if a
+  // refinement that ends below its limit is the one a larger limit gives, and one that would go past it stops at it.
+  for (const set_case& sc : set_cases) {
+    light_set s = make_light_set(sc.seed, sc.n, sc.kind, sc.two_sided);
+    const light_tree_data& t = s.tree;
+    pcg32 rng(sc.seed, 29);
+    for (int k = 0; k < 20; k++) {
+      bbox3f box = random_region_box(rng, s.scene.bounds);
+      region_params p;
+      p.max_cut = k % 2 ? 8 : 64;
+      std::vector<int> cut = compute_light_cut(t, box, k % 3 == 1, p);
+      std::vector<int> full, full_group;
+      compute_members(t, box, cut, 1024, full, full_group);
+      int n = int(full.size());
+      for (int limit : {int(cut.size()), int(cut.size()) + 1, n / 2 + 1, n - 1, n, n + 1, 1023}) {
+        if (limit < 1) continue;
+        std::vector<int> m, g;
+        compute_members(t, box, cut, limit, m, g);
+        INFO("set " << sc.name << " box " << k << ": " << n << " members in full, limit " << limit);
+        if (n < limit) {
+          CHECK(m == full);
+          CHECK(g == full_group);
+        } else {
+          CHECK(int(m.size()) == std::max(limit, int(cut.size())));
+        }
+      }
+    }
+  }
+}
+
 TEST_CASE("a cut's members partition its clusters' lights that can reach the box", "[light_tree]") {
   for (const set_case& sc : set_cases) {
     light_set s = make_light_set(sc.seed, sc.n, sc.kind, sc.two_sided);
