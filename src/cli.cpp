@@ -257,7 +257,18 @@ void warn_unused_options(const render_options& o, const std::vector<sampler_kind
 
 // Fine regions at depths the paths never reach change nothing either: named in a warning when a sampler of `kinds`
 // has regions (warn_unused_options runs before the scene, which may give the max depth, is read).
-void warn_fine_depth(const render_options& o, int max_depth, const std::vector<sampler_kind>& kinds) {
+void warn_after_scene(const render_options& o, const render_params& params, const std::vector<sampler_kind>& kinds) {
+  // donikian keeps every pixel's estimate of each cluster of its cut (up to --max-cut and the sun, 4 bytes each): 6.7
+  // GB at 4096x4096 in a review, with nothing said before.
+  if (std::find(kinds.begin(), kinds.end(), sampler_kind::donikian) != kinds.end()) {
+    const double bytes = double(params.width) * params.height * (double(o.regions.max_cut) + 2) * 4;
+    if (bytes > 4.0 * (1 << 30))
+      std::fprintf(stderr,
+                   "bayeslight: warning: donikian keeps each pixel's estimate of every cluster of its cut: up to %.0f "
+                   "GB at %dx%d with --max-cut %d (a smaller image or --max-cut takes less)\n",
+                   bytes / (1 << 30), params.width, params.height, o.regions.max_cut);
+  }
+  const int max_depth = params.max_depth;
   bool given = false, used = false;
   for (const auto& g : o.given) given |= g.first == "--fine-depth";
   for (sampler_kind k : kinds) used |= unused_because("--fine-depth", region_group, k, o).empty();
@@ -325,7 +336,7 @@ int run_render(const render_options& o) {
 
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
-  warn_fine_depth(o, params.max_depth, {kind});
+  warn_after_scene(o, params, {kind});
   if (o.frames > 1 && !(desc.sun.enabled && desc.sun.animated))
     std::fprintf(stderr, "%s: warning: %s, so the %d frames show the same scene (the sun moves to sun.direction_end)\n",
                  o.scene.c_str(), desc.sun.enabled ? "the sun has no \"direction_end\"" : "the scene has no sun",
@@ -748,7 +759,7 @@ int run_profile_command(const render_options& o) {
   warn_unused_options(o, {kind});
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
-  warn_fine_depth(o, params.max_depth, {kind});
+  warn_after_scene(o, params, {kind});
   std::optional<slow_phase_note> loading(std::in_place, params.notes, "loading " + o.scene + " ...");
   params.progress = false;  // (the timed stages must not share the machine with the bar; the notes stay)
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
@@ -809,7 +820,7 @@ int run_compare_command(const compare_options& o) {
   warn_unused_options(o.render, cp.samplers);
   scene_desc desc = load_scene_desc(o.render.scene);
   cp.render = resolve_params(o.render, desc, cp.samplers[0]);
-  warn_fine_depth(o.render, cp.render.max_depth, cp.samplers);
+  warn_after_scene(o.render, cp.render, cp.samplers);
   cp.runs = o.runs;
   cp.scene_path = o.render.scene;
   cp.reference_path = o.render.reference;

@@ -869,6 +869,20 @@ TEST_CASE("a region budget that allows gigabytes of statistics is named in a war
   }
 }
 
+TEST_CASE("donikian's per-pixel statistics beyond 4 GB are named in a warning", "[cli]") {
+  // (The tiny scene has few lights: the render itself stays small, the warning gives the most --max-cut allows.)
+  tiny_scene s;
+  const std::string base = "render " + s.json + " --sampler donikian --spp 1 --quiet -o " + (s.dir / "a.pfm");
+  auto r = run_bayeslight(base + " --width 1024 --height 1024 --max-cut 1024");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("donikian keeps each pixel's estimate of every cluster of its cut: up to 4 GB at 1024x1024") !=
+        std::string::npos);
+  r = run_bayeslight(base + " --width 1024 --height 1024");
+  INFO(r.output);
+  CHECK(r.output.find("donikian keeps") == std::string::npos);
+}
+
 TEST_CASE("real-valued options take plain decimals with a fraction and exponent", "[cli]") {
   tiny_scene s;
   for (const char* v : {"0.5", ".5", "5.", "5e-1", "0.05E+1", "-0"}) {
