@@ -19,8 +19,9 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 6: bayes fallback check; 7: no point-prior weights in region-prior mode; 8: the stratified set's first sample;
 // 9: members; 10: reversed twin faces (a ray meets the one turned toward it); 11: hashed per-vertex PCG32 seeds; 12: the
 // reference's hash; 13: the region options as resolved in the fingerprint, Kd 0 for a library material without one;
-// 14: hits on huge triangles take the ray's point, a thin scene's cells its own shortest extent
-constexpr uint32_t version = 14;
+// 14: hits on huge triangles take the ray's point, a thin scene's cells its own shortest extent; 15: map_d's -imfchan
+// and an RGB mask's luminance, cells of at least 4 ulps
+constexpr uint32_t version = 15;
 
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
@@ -322,7 +323,8 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
     h.vec(mat.kd), h.vec(mat.ks), h.vec(mat.ke), h.value(mat.ns);
     h.value(mat.kd_texture), h.value(mat.alpha_texture);
     for (const texture_transform* t : {&mat.kd_map, &mat.alpha_map})
-      h.value(t->scale.x), h.value(t->scale.y), h.value(t->offset.x), h.value(t->offset.y), h.value(t->clamp);
+      h.value(t->scale.x), h.value(t->scale.y), h.value(t->offset.x), h.value(t->offset.y), h.value(t->clamp),
+          h.value(t->channel);
   }
   for (const texture_data& t : m.textures) {
     h.value(t.width), h.value(t.height);

@@ -256,6 +256,8 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   std::vector<int> local;
   int default_material = int(clean.materials.size());
   size_t next_corner = 0;
+  int64_t untextured = 0;   // faces of a textured material with a corner without vt
+  int untextured_material = invalid_id;  // the first such face's material
   for (size_t face = 0; face < clean.face_sizes.size(); face++) {
     int n = clean.face_sizes[face];
     const obj_corner* c = &clean.corners[next_corner];
@@ -264,6 +266,12 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
     for (int i = 0; i < n; i++) corner_pos[size_t(i)] = position(size_t(c[i].v));
     triangulate_polygon(corner_pos, st, local);
     int material = clean.face_materials[face] >= 0 ? clean.face_materials[face] : default_material;
+    if (material != default_material && (!clean.materials[size_t(material)].kd_map.empty() ||
+                                         !clean.materials[size_t(material)].alpha_map.empty())) {
+      bool missing = false;
+      for (int i = 0; i < n; i++) missing = missing || c[i].vt < 0;
+      if (missing && untextured++ == 0) untextured_material = material;
+    }
     int kept = 0, flat = 0, unusable = 0;
     for (size_t t = 0; t < local.size(); t += 3) {
       const obj_corner* tc[3] = {&c[local[t]], &c[local[t + 1]], &c[local[t + 2]]};
@@ -304,6 +312,11 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   if (copies > 0)
     stderr_text() << "warning: " << path << ": dropped " << copies << " triangle" << (copies > 1 ? "s" : "")
                   << " repeating another (same corners, same side; an emissive one is kept first, else the first)\n";
+  if (untextured > 0)
+    stderr_text() << "warning: " << path << ": " << untextured << " face" << (untextured > 1 ? "s" : "")
+                  << " of a textured material (the first: \"" << clean.materials[size_t(untextured_material)].material.name
+                  << "\") " << (untextured > 1 ? "have" : "has") << " a corner without texture coordinates (vt): "
+                  << "texture coordinates (0, 0) are used there\n";
   if (st.fan_fallbacks > 0)
     stderr_text() << "warning: " << path << ": " << st.fan_fallbacks
                   << " polygon(s) that cross themselves, too complex to ear-clip in the time budget, were "

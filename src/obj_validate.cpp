@@ -347,10 +347,18 @@ static const texture_option texture_options[] = {
     {"-type", -1, 1},   {"-colorspace", -1, 1}, {"-boost", 1, 1},  {"-bm", 1, 1},  {"-texres", 1, 1},
     {"-mm", 1, 2},      {"-o", 1, 3},           {"-s", 1, 3},      {"-t", 1, 3}};
 
-// Checks a texture statement (options, then a file name) and returns the file name; -s, -o and -clamp go to xf (when
-// given): u and v of -s and -o (a v left out is u's default, 1 for -s and 0 for -o; w has no use on a 2D image).
+// Checks a texture statement (options, then a file name) and returns the file name; -s, -o, -clamp and (map_d)
+// -imfchan go to xf (when given): u and v of -s and -o (a v left out is u's default, 1 for -s and 0 for -o; w has no
+// use on a 2D image). Options given that would change the texture but are not applied are appended to not_applied
+// (when given): -mm other than 0 1, -t other than 0, -cc on, -blendu or -blendv off, -colorspace, -imfchan z or on a
+// colour texture. (-boost, -texres, -type and -bm change nothing of a 2D colour or cut-out texture without mipmaps.)
 static std::string check_texture_statement(const std::vector<string_view>& t, const text_pos& pos,
-                                           texture_transform* xf = nullptr) {
+                                           texture_transform* xf = nullptr,
+                                           std::vector<std::string>* not_applied = nullptr) {
+  auto skip = [&](string_view name) {
+    if (not_applied) not_applied->emplace_back(name);
+  };
+  const bool scalar = ascii_lower(t[0]) == "map_d";
   texture_transform local;
   if (!xf) xf = &local;
   *xf = {};
@@ -366,6 +374,14 @@ static std::string check_texture_statement(const std::vector<string_view>& t, co
       bool on_off = name == "-blendu" || name == "-blendv" || name == "-clamp" || name == "-cc";
       if (on_off && t[i] != "on" && t[i] != "off") fail(pos, "texture option " + quote(name) + " takes on or off");
       if (name == "-clamp") xf->clamp = t[i] == "on";
+      if (name == "-imfchan") {
+        const std::string c = ascii_lower(t[i]);
+        if (scalar && (c == "r" || c == "g" || c == "b" || c == "m" || c == "l")) xf->channel = c[0];
+        else skip(name);  // (z, depth, or a word the format does not define; or a colour texture's channel)
+      }
+      if ((name == "-cc" && t[i] == "on") || ((name == "-blendu" || name == "-blendv") && t[i] == "off") ||
+          name == "-colorspace")
+        skip(name);
       i++;
       continue;
     }
@@ -383,6 +399,9 @@ static std::string check_texture_statement(const std::vector<string_view>& t, co
       got++;
       i++;
     }
+    if ((name == "-mm" && (args[0] != 0 || (got > 1 && args[1] != 1))) ||
+        (name == "-t" && (args[0] != 0 || args[1] != 0 || args[2] != 0)))
+      skip(name);
     if (name == "-s") xf->scale = {args[0], got > 1 ? args[1] : 1.0f};
     if (name == "-o") xf->offset = {args[0], got > 1 ? args[1] : 0.0f};
   }
@@ -422,6 +441,8 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
   size_t transparent_line = 0;  // the first d or Tr statement asking for partial transparency (reported once)
   std::map<std::string, size_t> ignored_maps;  // texture statements other than map_Kd and map_d: first line of each
   std::vector<std::string> ignored_order;     // their keywords in order of first appearance
+  std::map<std::string, size_t> skipped_options;  // options of map_Kd and map_d that are not applied: first line
+  std::vector<std::string> skipped_order;
   std::vector<string_view> named;  // a name statement's tokens, '#' inside names kept (see tokenize)
   const std::string dir = fs::path(path).parent_path().string();
   while (lines.next(line)) {
@@ -460,7 +481,11 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
       if (k != "map_Kd" && k != "map_d" && ignored_maps.emplace(std::string(k), lines.line).second)
         ignored_order.emplace_back(k);
       texture_transform xf;
-      std::string file = check_texture_statement(named, pos, &xf);
+      std::vector<std::string> skipped;
+      std::string file = check_texture_statement(named, pos, &xf, &skipped);
+      if (k == "map_Kd" || k == "map_d")  // (the other maps are named as not rendered at all)
+        for (const std::string& o : skipped)
+          if (skipped_options.emplace(o, lines.line).second) skipped_order.push_back(o);
       // "map_Kd wood.png #2": a file name with a '#' word when there is such a file (here, or beside the MTL when the
       // word is in its last path component: "C:\...\Wood #2.png"), else a comment after the name.
       std::error_code ec;
@@ -526,6 +551,13 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     w << "warning: " << path << ": textures other than map_Kd and map_d are not rendered:";
     for (size_t i = 0; i < ignored_order.size(); i++)
       w << (i ? ", " : " ") << ignored_order[i] << " (line " << ignored_maps[ignored_order[i]] << ")";
+    w << "\n";
+  }
+  if (!skipped_order.empty()) {
+    stderr_text w;
+    w << "warning: " << path << ": texture options that are not applied (the texture is used without them):";
+    for (size_t i = 0; i < skipped_order.size(); i++)
+      w << (i ? ", " : " ") << skipped_order[i] << " (line " << skipped_options[skipped_order[i]] << ")";
     w << "\n";
   }
   if (transparent_line > 0)

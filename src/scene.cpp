@@ -151,7 +151,7 @@ bool alpha_hole(const scene_data& scene, int tri, float b1, float b2) {
   const material_data& m = scene.mesh.materials[size_t(scene.mesh.tri_materials[size_t(tri)])];
   if (m.alpha_texture == invalid_id) return false;
   vec2f uv = transform_uv(m.alpha_map, surface_uv(scene, tri, b1, b2));
-  return eval_texture_alpha(scene.mesh.textures[size_t(m.alpha_texture)], uv, m.alpha_map.clamp) < 0.5f;
+  return eval_texture_alpha(scene.mesh.textures[size_t(m.alpha_texture)], uv, m.alpha_map.clamp, m.alpha_map.channel) < 0.5f;
 }
 
 }  // namespace bl

@@ -318,11 +318,11 @@ vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp) {
   return lo * (1.0f - wb) + hi * wb;
 }
 
-float eval_texture_alpha(const texture_data& tex, vec2f uv, bool clamp) {
+float eval_texture_alpha(const texture_data& tex, vec2f uv, bool clamp, char channel) {
   if (!texture_complete(tex)) return 1.0f;
   int x = axis_nearest(clamp ? clamp01(uv.x) : wrap01(uv.x), tex.width);
   int y = tex.height - 1 - axis_nearest(clamp ? clamp01(uv.y) : wrap01(uv.y), tex.height);
-  return texel_alpha(tex, size_t(y) * size_t(tex.width) + size_t(x));
+  return texel_alpha(tex, size_t(y) * size_t(tex.width) + size_t(x), channel);
 }
 
 }  // namespace bl

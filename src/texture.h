@@ -21,7 +21,7 @@ constexpr uint64_t max_textures_bytes = uint64_t(1) << 32;
 
 // One decoded texture, kept as the file's own 8- or 16-bit channels (a quarter of the memory of float RGB + alpha:
 // a 4096² RGBA texture takes 64 MiB), decoded per lookup through a fixed table: texel_rgb is linear RGB, texel_alpha
-// the cut-out mask in [0, 1] (from the alpha channel when the image has one, else from its first channel).
+// the cut-out mask in [0, 1] (by default from the alpha channel when the image has one, else its luminance).
 // Texels are row-major, top row first.
 struct texture_data {
   std::string path;
@@ -43,10 +43,21 @@ inline vec3f texel_rgb(const texture_data& t, size_t i) {
   size_t c = i * size_t(t.channels);
   return t.texels8.empty() ? decode_texel(t, t.texels16.data() + c) : decode_texel(t, t.texels8.data() + c);
 }
-inline float texel_alpha(const texture_data& t, size_t i) {
-  size_t a = i * size_t(t.channels) + size_t(t.channels == 2 || t.channels == 4 ? t.channels - 1 : 0);
-  if (!t.texels8.empty()) return float(t.texels8[a]) * (1.0f / 255.0f);
-  return float(t.texels16[a]) * (1.0f / 65535.0f);
+// The cut-out mask of texel i from `channel` (texture_transform::channel), values linear (value / max): 'm' and the
+// default take the alpha channel of an image that has one; 'l' and the default, of an RGB image without one, its
+// luminance (the MTL format's default for scalar textures; the red channel alone before: a green mask cut out its
+// complement); 'r', 'g', 'b' that channel; a grey image's grey value wherever there is no such channel.
+inline float texel_alpha(const texture_data& t, size_t i, char channel = 0) {
+  const size_t c = i * size_t(t.channels);
+  auto value = [&](int k) {
+    return t.texels8.empty() ? float(t.texels16[c + size_t(k)]) * (1.0f / 65535.0f)
+                             : float(t.texels8[c + size_t(k)]) * (1.0f / 255.0f);
+  };
+  const bool alpha = t.channels == 2 || t.channels == 4, rgb = t.channels >= 3;
+  if (alpha && (channel == 0 || channel == 'm')) return value(t.channels - 1);
+  if (rgb && (channel == 'r' || channel == 'g' || channel == 'b')) return value(channel == 'r' ? 0 : channel == 'g' ? 1 : 2);
+  if (rgb) return 0.2126f * value(0) + 0.7152f * value(1) + 0.0722f * value(2);
+  return value(0);
 }
 // Whether t holds all its texels at one bit depth (a default-constructed texture holds none).
 inline bool texture_complete(const texture_data& t) {
@@ -72,7 +83,7 @@ texture_data texture_from_texels8(std::string path, int width, int height, int c
 // Linear RGB at texture coordinate uv (bilinear; repeat wrap, or with clamp the edge texels beyond [0, 1]).
 vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp = false);
 // Alpha mask at uv (nearest texel; repeat wrap or clamp): cut-outs keep hard edges and cost one fetch.
-float eval_texture_alpha(const texture_data& tex, vec2f uv, bool clamp = false);
+float eval_texture_alpha(const texture_data& tex, vec2f uv, bool clamp = false, char channel = 0);
 
 // How a material's texture statement maps surface coordinates onto its image: MTL -s (scale) and -o (offset), u and
 // v (w has no use on a 2D image): the image is read at uv * scale + offset; -clamp on: not repeated.
@@ -80,6 +91,7 @@ struct texture_transform {
   vec2f scale = {1, 1};
   vec2f offset = {0, 0};
   bool clamp = false;
+  char channel = 0;  // map_d's -imfchan: 'r', 'g', 'b', 'm' (the alpha channel) or 'l' (luminance); 0: the default
 };
 inline vec2f transform_uv(const texture_transform& t, vec2f uv) {
   return {uv.x * t.scale.x + t.offset.x, uv.y * t.scale.y + t.offset.y};

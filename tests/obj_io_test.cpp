@@ -1415,3 +1415,57 @@ TEST_CASE("corners beyond 1e18 of the origin are refused, naming the vertex", "[
   auto edge = dir.write("edge.obj", "v 1e18 0 0\nv 1e18 1 0\nv 1e18 0 1\nf 1 2 3\n");  // at the limit: kept
   CHECK(load_error(edge).empty());
 }
+
+TEST_CASE("map_d takes the channel -imfchan names, an RGB mask's luminance by default", "[obj]") {
+  // An RGB mask without alpha was read by its red channel, and -imfchan was ignored: a green mask written with
+  // "-imfchan g" cut out its complement (a review). The MTL format's default for scalar textures is luminance.
+  temp_dir dir;
+  const unsigned char px[9] = {0, 255, 0, 255, 0, 0, 0, 0, 255};  // green, red, blue
+  REQUIRE(stbi_write_png((dir.path + "/m.png").c_str(), 3, 1, 3, px, 9) != 0);
+  dir.write("lib.mtl", "newmtl plain\nmap_d m.png\nnewmtl green\nmap_d -imfchan g m.png\n"
+                       "newmtl depth\nmap_d -imfchan z m.png\nnewmtl upper\nMAP_D -imfchan R m.png\n");
+  auto obj = dir.write("t.obj", "mtllib lib.mtl\n" + std::string(square_vertices) + "vt 0 0\n"
+                                "usemtl plain\nf 1/1 2/1 3/1\nusemtl green\nf 1/1 3/1 4/1\n"
+                                "usemtl depth\nf 1/1 2/1 4/1\nusemtl upper\nf 2/1 3/1 4/1\n");
+  mesh_data m;
+  std::string warnings = load_warnings(obj, &m);
+  REQUIRE(m.textures.size() == 1);
+  REQUIRE(m.materials.size() == 4);
+  const texture_data& t = m.textures[0];
+  CHECK(m.materials[0].alpha_map.channel == 0);
+  CHECK(m.materials[1].alpha_map.channel == 'g');
+  CHECK(m.materials[2].alpha_map.channel == 0);  // depth has no meaning here: named as not applied
+  CHECK(m.materials[3].alpha_map.channel == 'r');
+  CHECK(texel_alpha(t, 0) == Approx(0.7152f));  // luminance
+  CHECK(texel_alpha(t, 1) == Approx(0.2126f));
+  CHECK(texel_alpha(t, 2) == Approx(0.0722f));
+  CHECK(texel_alpha(t, 0, 'g') == 1.0f);
+  CHECK(texel_alpha(t, 1, 'g') == 0.0f);
+  CHECK(texel_alpha(t, 1, 'r') == 1.0f);
+  CHECK(texel_alpha(t, 2, 'b') == 1.0f);
+  CHECK(texel_alpha(t, 0, 'm') == Approx(0.7152f));  // no alpha channel: luminance
+  CHECK(eval_texture_alpha(t, {0.1f, 0.5f}, false, 'g') == 1.0f);
+  CHECK(eval_texture_alpha(t, {0.5f, 0.5f}, false, 'g') == 0.0f);
+  CHECK_THAT(warnings, Catch::Contains("texture options that are not applied (the texture is used without them): "
+                                       "-imfchan (line 6)"));
+}
+
+TEST_CASE("texture options that are not applied, and textured faces without vt, are named in a warning", "[obj]") {
+  temp_dir dir;
+  write_png(dir, "a.png");
+  dir.write("lib.mtl", "newmtl a\nmap_Kd -mm 0 1 -t 0 0 0 -blendu on -cc off -bm 2 -boost 1 a.png\n"
+                       "newmtl b\nmap_Kd -mm 0.2 0.5 -cc on a.png\nmap_d -blendv off -t 0.1 a.png\n");
+  auto obj = dir.write("t.obj", "mtllib lib.mtl\n" + std::string(square_vertices) + "vt 0 0\n"
+                                "usemtl a\nf 1/1 2/1 3/1\nusemtl b\nf 1 3 4\nf 1/1 2/1 4\n");
+  mesh_data m;
+  std::string warnings = load_warnings(obj, &m);
+  INFO(warnings);
+  CHECK_THAT(warnings, Catch::Contains("lib.mtl: texture options that are not applied (the texture is used without "
+                                       "them): -mm (line 4), -cc (line 4), -blendv (line 5), -t (line 5)\n"));
+  CHECK_THAT(warnings, Catch::Contains("t.obj: 2 faces of a textured material (the first: \"b\") have a corner without "
+                                       "texture coordinates (vt)"));
+  // Defaults written out (as exporters do) and options that change nothing of a 2D texture: no warning.
+  auto quiet = dir.write("q.obj", "mtllib lib.mtl\n" + std::string(square_vertices) + "vt 0 0\nusemtl a\nf 1/1 2/1 3/1\n");
+  dir.write("lib.mtl", "newmtl a\nmap_Kd -mm 0 1 -t 0 0 0 -blendu on -cc off -bm 2 -boost 1 -texres 8 -type sphere a.png\n");
+  CHECK(load_warnings(quiet) == "");
+}

@@ -83,9 +83,11 @@ TEST_CASE("an RGB PNG decodes to linear texels top row first", "[texture]") {
   CHECK(texel_rgb(t, 0).x == srgb8_to_linear(128));
   CHECK(texel_rgb(t, 1).x == 1.0f);
   CHECK(texel_rgb(t, 1).y == 0.0f);
-  // Without an alpha channel the mask is the first channel, linear.
+  // Without an alpha channel the mask is the luminance of the linear values (the MTL format's default for scalar
+  // textures; the first channel until a review found a green mask cutting out its complement).
   CHECK(texel_alpha(t, 0) == Approx(128.0f / 255.0f));
-  CHECK(texel_alpha(t, 1) == 1.0f);
+  CHECK(texel_alpha(t, 1) == Approx(0.2126f));
+  CHECK(texel_alpha(t, 1, 'r') == 1.0f);
   // Kept as the file's own bytes (3 per texel here), not as float RGB + alpha (16 per texel): a 4096² RGBA texture
   // takes 64 MiB, not 256 MiB.
   CHECK(t.channels == 3);
