@@ -310,9 +310,14 @@ vec3f animated_sun_direction(const sun_params& sun, int frame, int frames) {
   if (angle < 1e-6f) {
     d = a * (1 - t) + b * t;
   } else {
-    // Spherical interpolation; for opposite directions pick any great circle through a.
+    // Spherical interpolation. Opposite directions have no one great circle between them: the sun passes over the
+    // zenith, +y (a sunrise [1, 0, 0] to a sunset [-1, 0, 0] went round the horizon, a dark animation: a review),
+    // or where a is +-y itself, through +x.
     vec3f perp = b - a * cos_ab;
-    if (!(length(perp) > 1e-6f)) perp = cross(a, std::fabs(a.x) < 0.9f ? vec3f{1, 0, 0} : vec3f{0, 1, 0});
+    if (!(length(perp) > 1e-6f)) {
+      perp = vec3f{0, 1, 0} - a * a.y;
+      if (!(length(perp) > 1e-3f)) perp = vec3f{1, 0, 0} - a * a.x;
+    }
     perp = normalize(perp);
     d = a * std::cos(t * angle) + perp * std::sin(t * angle);
   }

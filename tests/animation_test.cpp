@@ -94,6 +94,31 @@ TEST_CASE("each frame of a non learning sampler equals a single render with that
   CHECK(length(desc.sun.direction_end - normalize(sun_end)) < 1e-6f);
 }
 
+TEST_CASE("the sun moves along the great circle, over the zenith between opposite directions", "[animation]") {
+  // Slerp at t = k / (N - 1): the angle to the start grows evenly. A sunrise [1, 0, 0] to a sunset [-1, 0, 0] has no
+  // one great circle: it went round the horizon (a dark animation, a review); it passes overhead now.
+  sun_params sun;
+  sun.animated = true;
+  sun.direction = normalize(vec3f{1, 1, 0});
+  sun.direction_end = normalize(vec3f{-1, 1, 0});
+  for (int k = 0; k < 5; k++) {
+    vec3f d = animated_sun_direction(sun, k, 5);
+    CHECK(std::acos(std::min(1.0f, dot(d, sun.direction))) == Approx(0.25 * k * M_PI / 2).margin(1e-3));  // (float acos near 1)
+    CHECK(d.z == Approx(0).margin(1e-6));
+  }
+  struct pair_case {
+    vec3f from, mid;  // the opposite end is -from; mid: the halfway direction
+  };
+  for (const pair_case& c : {pair_case{{1, 0, 0}, {0, 1, 0}}, pair_case{{0, 0, -1}, {0, 1, 0}},
+                             pair_case{{0, 1, 0}, {1, 0, 0}}, pair_case{{0, -1, 0}, {1, 0, 0}}}) {
+    sun.direction = c.from;
+    sun.direction_end = c.from * -1.0f;
+    vec3f mid = animated_sun_direction(sun, 2, 5);
+    INFO(c.from.x << " " << c.from.y << " " << c.from.z << " -> " << mid.x << " " << mid.y << " " << mid.z);
+    CHECK(length(mid - c.mid) < 1e-5f);
+  }
+}
+
 TEST_CASE("learning samplers animate deterministically and agree with single renders", "[animation]") {
   anim_scene a;
   std::string anim = a.scene("anim.json", sun_start, &sun_end);
