@@ -455,6 +455,7 @@ int run_render(const render_options& o) {
   if (int status = interrupted_before_render()) return status;
   bool interrupted = false;
   output_failures failures;  // every output is tried (and every frame rendered) whatever failed before it
+  failures.say_now = params.frames > 1;
   render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
     std::vector<std::string> files;
     // (A 4096^2 EXR takes seconds to compress and write after the bar has reached its end.)

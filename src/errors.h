@@ -35,6 +35,10 @@ struct output_error : std::runtime_error {
 // output that cannot be written (a full disk, a FIFO's reader gone) does not lose the outputs after it.
 struct output_failures {
   std::string messages;  // one per line
+  // An animation says each failure when it happens (a frame's unwritable output was named only after the last
+  // frame: a review), and at the end how many there were.
+  bool say_now = false;
+  int count = 0;
   // Runs write(); an output_error it throws is kept (false) instead of ending the caller.
   template <class F>
   bool attempt(F&& write) {
@@ -42,13 +46,20 @@ struct output_failures {
       write();
       return true;
     } catch (const output_error& e) {
+      count++;
+      if (say_now) std::fprintf(stderr, "bayeslight: error: %s (the animation goes on)\n", e.what());
       messages += (messages.empty() ? "" : "\nbayeslight: error: ") + std::string(e.what());
       return false;
     }
   }
-  // Throws one output_error naming every failure (each on its own line, as main prints errors), if any.
+  // Throws one output_error naming every failure (each on its own line, as main prints errors), if any; once said,
+  // their count.
   void rethrow() const {
-    if (!messages.empty()) throw output_error(messages);
+    if (count == 0) return;
+    if (say_now)
+      throw output_error(std::to_string(count) + " output" + (count > 1 ? "s" : "") +
+                         " could not be written (each named above)");
+    throw output_error(messages);
   }
 };
 
