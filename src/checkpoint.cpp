@@ -341,17 +341,29 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   // cannot change its image) was refused as a different render.
   const sampler_kind k = p.sampler.kind;
   const bool regions = k == sampler_kind::bound || k == sampler_kind::donikian || k == sampler_kind::bayes;
-  if (k == sampler_kind::donikian || k == sampler_kind::bayes) h.value(p.pass_weighting);  // the adaptive ones
+  // Nor the options the others leave without effect (as the command line's warning names them: a resume with
+  // --pass-weighting 8 of a --bayes-oracle render was refused right after the warning said it was ignored; a review).
+  const bool frozen = k == sampler_kind::bayes && p.sampler.bayes.oracle_spp > 0;
+  if ((k == sampler_kind::donikian || k == sampler_kind::bayes) && !frozen) h.value(p.pass_weighting);  // adaptive
   if (regions) {
     // As the render resolves them: a default given explicitly (--cut-members 128 in direct illumination, the automatic
-    // pair budget) renders the same image and was refused as a different render.
+    // pair budget) renders the same image and was refused as a different render. donikian's first hit reads only
+    // its cut's options; its regions serve the vertices past it.
     const region_params r = effective_region_params(p.sampler, p.max_depth, int64_t(p.width) * p.height);
-    h.value(r.grid), h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
-    h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
-    h.value(r.max_members);
+    h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
+    if (k != sampler_kind::donikian || p.max_depth > 1) {
+      h.value(r.grid), h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
+      h.value(r.max_members);
+    }
   }
   if (k == sampler_kind::bayes) {
-    const bayes_params& b = p.sampler.bayes;
+    bayes_params b = p.sampler.bayes;
+    const bayes_params d;
+    if (!b.prior) b.a0 = d.a0, b.b0 = d.b0, b.kappa0 = d.kappa0, b.alpha0 = d.alpha0, b.c = d.c;
+    if (!b.region_prior) b.orientation = d.orientation, b.bsdf_factor = d.bsdf_factor, b.control_variate = d.control_variate;
+    if (!b.region_prior || !b.second_moment || !b.control_variate) b.cv_min_visible = d.cv_min_visible;
+    if (!b.second_moment) b.control_variate = d.control_variate;
+    if (!b.prior || !b.region_prior || !(b.hierarchy > 0)) b.mean_hierarchy = d.mean_hierarchy;
     h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
     h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
     h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);

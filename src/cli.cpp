@@ -241,26 +241,31 @@ void warn_unused_options(const render_options& o, const std::vector<sampler_kind
   if (!unused.empty())
     std::fprintf(stderr, "bayeslight: warning: options that change nothing in this run are ignored: %s\n",
                  unused.c_str());
-  // A budget near its maximum lets a fine grid's regions take tens of GB (a review: 10 GB at 160x120 with --grid
-  // 100000 --region-min-samples 1): said before the render, with what it can cost. About 130 bytes per pair (the
-  // statistics and weight columns, the cut entries), fine and coarse pairs up to twice the budget.
-  constexpr double bytes_per_pair = 130, warn_bytes = 4.0 * (1 << 30);
-  bool regions = false;
-  for (sampler_kind k : kinds) regions |= unused_because("--region-budget", region_group, k, o).empty();
-  const double most = 2.0 * double(o.regions.max_pairs) * bytes_per_pair;
-  if (regions && o.regions.max_pairs > 0 && most > warn_bytes)
-    std::fprintf(stderr,
-                 "bayeslight: warning: --region-budget %lld lets the regions' statistics grow to about %.0f GB where "
-                 "the samples reach that many cells (a fine --grid, a small --region-min-samples)\n",
-                 (long long)o.regions.max_pairs, most / (1 << 30));
 }
 
-// Fine regions at depths the paths never reach change nothing either: named in a warning when a sampler of `kinds`
-// has regions (warn_unused_options runs before the scene, which may give the max depth, is read).
+// What only the scene (its max depth, image size) tells: fine regions at depths the paths never reach, donikian's
+// region options at max depth 1, and settings that may take gigabytes (warn_unused_options runs before the scene is
+// read). Each option is named once.
 void warn_after_scene(const render_options& o, const render_params& params, const std::vector<sampler_kind>& kinds) {
+  const int max_depth = params.max_depth;
+  const bool donikian = std::find(kinds.begin(), kinds.end(), sampler_kind::donikian) != kinds.end();
+  // Whether a sampler of `kinds` reads a region option at this max depth: donikian's regions are bound's, for the
+  // vertices past the first; its first hit reads only --max-cut and --cut-coherence (its cut over the scene).
+  auto read_now = [&](const std::string& name) {
+    for (sampler_kind k : kinds)
+      if (unused_because(name, region_group, k, o).empty() &&
+          (k != sampler_kind::donikian || max_depth > 1 || name == "--max-cut" || name == "--cut-coherence"))
+        return true;
+    return false;
+  };
+  auto given = [&](const std::string& name) {
+    for (const auto& g : o.given)
+      if (g.first == name) return true;
+    return false;
+  };
   // donikian keeps every pixel's estimate of each cluster of its cut (up to --max-cut and the sun, 4 bytes each): 6.7
   // GB at 4096x4096 in a review, with nothing said before.
-  if (std::find(kinds.begin(), kinds.end(), sampler_kind::donikian) != kinds.end()) {
+  if (donikian) {
     const double bytes = double(params.width) * params.height * (double(o.regions.max_cut) + 2) * 4;
     if (bytes > 4.0 * (1 << 30))
       std::fprintf(stderr,
@@ -268,24 +273,29 @@ void warn_after_scene(const render_options& o, const render_params& params, cons
                    "GB at %dx%d with --max-cut %d (a smaller image or --max-cut takes less)\n",
                    bytes / (1 << 30), params.width, params.height, o.regions.max_cut);
   }
-  const int max_depth = params.max_depth;
-  bool given = false, used = false;
-  for (const auto& g : o.given) given |= g.first == "--fine-depth";
+  // A budget near its maximum lets a fine grid's regions take tens of GB (a review: 10 GB at 160x120 with --grid
+  // 100000 --region-min-samples 1): said before the render, with what it can cost. About 130 bytes per pair (the
+  // statistics and weight columns, the cut entries), fine and coarse pairs up to twice the budget.
+  constexpr double bytes_per_pair = 130, warn_bytes = 4.0 * (1 << 30);
+  const double most = 2.0 * double(o.regions.max_pairs) * bytes_per_pair;
+  if (o.regions.max_pairs > 0 && most > warn_bytes && read_now("--region-budget"))
+    std::fprintf(stderr,
+                 "bayeslight: warning: --region-budget %lld lets the regions and their statistics grow to about %.0f "
+                 "GB where the samples reach that many cells (a fine --grid, a small --region-min-samples)\n",
+                 (long long)o.regions.max_pairs, most / (1 << 30));
+  bool used = false;
   for (sampler_kind k : kinds) used |= unused_because("--fine-depth", region_group, k, o).empty();
-  if (given && used && o.regions.fine_depth > max_depth)
+  const bool deep_fine = given("--fine-depth") && used && o.regions.fine_depth > max_depth;
+  if (deep_fine)
     std::fprintf(stderr, "bayeslight: warning: --fine-depth %d is above the max depth %d: depths past %d change nothing\n",
                  o.regions.fine_depth, max_depth, max_depth);
-  // donikian's regions are bound's, for the vertices past the first; its first hit reads only --max-cut and
-  // --cut-coherence (its cut over the scene). Named when no sampler of `kinds` reads them at this max depth.
-  if (max_depth > 1 || std::find(kinds.begin(), kinds.end(), sampler_kind::donikian) == kinds.end()) return;
+  if (!donikian || max_depth > 1) return;
   std::string unused;
   for (const auto& [name, group] : o.given) {
-    if (group != region_group || name == "--max-cut" || name == "--cut-coherence" ||
+    if (group != region_group || read_now(name) || (name == "--fine-depth" && deep_fine) ||
         !unused_because(name, group, sampler_kind::donikian, o).empty())  // (warned about already)
       continue;
-    bool read = false;
-    for (sampler_kind k : kinds) read |= k != sampler_kind::donikian && unused_because(name, group, k, o).empty();
-    if (!read) unused += (unused.empty() ? "" : ", ") + name;
+    unused += (unused.empty() ? "" : ", ") + name;
   }
   if (!unused.empty())
     std::fprintf(stderr,
@@ -415,12 +425,18 @@ int run_render(const render_options& o) {
       }
       // An adaptive sampler's passes after a truncated one learn from other sample counts (and weigh theirs
       // otherwise) than one render's: still a correct image, but not the bytes the README promises at pass ends.
-      if (sampler_adapts(s) && !ends_scheduled_pass(r.spp, int64_t(r.width) * r.height) &&
-          (params.time_budget > 0 || params.spp > r.spp))
+      // Every pass of the saved render counts (a checkpoint of 10 spp reached through one of 9 is off schedule too).
+      int off = 0;
+      for (const pass_record& p : r.log)
+        if (!ends_scheduled_pass(p.spp, int64_t(r.width) * r.height)) {
+          off = p.spp;
+          break;
+        }
+      if (sampler_adapts(s) && off > 0 && (params.time_budget > 0 || params.spp > r.spp))
         std::fprintf(stderr,
-                     "%s: warning: its %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 ... do): the "
-                     "continued image is correct, but not bit-identical to one render of the final spp\n",
-                     o.resume.c_str(), r.spp);
+                     "%s: warning: its pass ending at %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 "
+                     "... do): the continued image is correct, but not bit-identical to one render of the final spp\n",
+                     o.resume.c_str(), off);
       // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
       if (params.time_budget <= 0 && r.spp > params.spp)
         throw usage_error((o.spp > 0 ? "--spp " + std::to_string(params.spp)

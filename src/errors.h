@@ -47,7 +47,7 @@ struct output_failures {
       return true;
     } catch (const output_error& e) {
       count++;
-      if (say_now) std::fprintf(stderr, "bayeslight: error: %s (the animation goes on)\n", e.what());
+      if (say_now) std::fprintf(stderr, "bayeslight: error: %s\n", e.what());
       messages += (messages.empty() ? "" : "\nbayeslight: error: ") + std::string(e.what());
       return false;
     }

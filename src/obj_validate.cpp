@@ -379,8 +379,11 @@ static std::string check_texture_statement(const std::vector<string_view>& t, co
         if (scalar && (c == "r" || c == "g" || c == "b" || c == "m" || c == "l")) xf->channel = c[0];
         else skip(name);  // (z, depth, or a word the format does not define; or a colour texture's channel)
       }
+      // (-colorspace as applied: colour textures are decoded as sRGB, masks read as they are stored)
+      const std::string space = ascii_lower(t[i]);
+      const bool as_applied = scalar ? space == "linear" || space == "raw" : space == "srgb";
       if ((name == "-cc" && t[i] == "on") || ((name == "-blendu" || name == "-blendv") && t[i] == "off") ||
-          name == "-colorspace")
+          (name == "-colorspace" && !as_applied))
         skip(name);
       i++;
       continue;

@@ -861,7 +861,7 @@ TEST_CASE("settings that may take gigabytes are named in a warning before the re
   // stay small, the warnings give the most the options allow.)
   tiny_scene s;
   const std::string base = "render " + s.json + " --spp 1 --quiet -o " + (s.dir / "a.pfm");
-  const std::string budget = "--region-budget 536870912 lets the regions' statistics grow to about 130 GB";
+  const std::string budget = "--region-budget 536870912 lets the regions and their statistics grow to about 130 GB";
   const std::string donikian = "donikian keeps each pixel's estimate of every cluster of its cut: up to 4 GB at 1024x1024";
   struct probe {
     std::string options, expect;  // expect: "" for no warning
@@ -1318,6 +1318,14 @@ TEST_CASE("resuming an adaptive render from a truncated pass warns that the byte
       CHECK(warned == (sampler == "bayes" && first == 9));
       CHECK(same == !warned);  // (the warning is true: those bytes differ, the others do not)
     }
+  // A chain: 9 spp, resumed to 10 (a scheduled end, but reached through 9), resumed to 12 (a review).
+  std::string base = "render " + d.json + " --quiet --sampler bayes --threads 2 -o " + (d.dir / "r.pfm");
+  std::string ck2 = d.dir / "ck2.bin";
+  REQUIRE(run_bayeslight(base + " --spp 9 --checkpoint " + ck).status == 0);
+  REQUIRE(run_bayeslight(base + " --spp 10 --resume " + ck + " --checkpoint " + ck2).status == 0);
+  auto r = run_bayeslight(base + " --spp 12 --resume " + ck2);
+  INFO(r.output);
+  CHECK(r.output.find("its pass ending at 9 spp did not end a scheduled pass") != std::string::npos);
 }
 
 TEST_CASE("a signal while the render sets up keeps the checkpoint and log already there", "[cli]") {

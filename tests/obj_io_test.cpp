@@ -1466,6 +1466,10 @@ TEST_CASE("texture options that are not applied, and textured faces without vt, 
                                        "texture coordinates (vt)"));
   // Defaults written out (as exporters do) and options that change nothing of a 2D texture: no warning.
   auto quiet = dir.write("q.obj", "mtllib lib.mtl\n" + std::string(square_vertices) + "vt 0 0\nusemtl a\nf 1/1 2/1 3/1\n");
-  dir.write("lib.mtl", "newmtl a\nmap_Kd -mm 0 1 -t 0 0 0 -blendu on -cc off -bm 2 -boost 1 -texres 8 -type sphere a.png\n");
+  dir.write("lib.mtl", "newmtl a\nmap_Kd -mm 0 1 -t 0 0 0 -blendu on -cc off -bm 2 -boost 1 -texres 8 -type sphere "
+                       "-colorspace sRGB a.png\nmap_d -colorspace linear a.png\n");
   CHECK(load_warnings(quiet) == "");
+  // A colour space other than the one applied (colour textures sRGB, masks as stored) is named.
+  dir.write("lib.mtl", "newmtl a\nmap_Kd -colorspace linear a.png\n");
+  CHECK_THAT(load_warnings(quiet), Catch::Contains("not applied (the texture is used without them): -colorspace (line 2)"));
 }

@@ -143,18 +143,22 @@ TEST_CASE("time spent between passes (checkpoints) counts in the render's second
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   };
   render_result r = render(b->scene, b->bvh, b->lights, p);
-  REQUIRE(calls == 6);
-  CHECK(r.seconds >= 0.3);
+  REQUIRE(calls == 5);  // between passes: not after the last one (the final call, last = true, comes then)
+  CHECK(r.seconds >= 0.25);
   REQUIRE(r.log.size() == 6);
   CHECK(r.log[5].seconds - r.log[0].seconds >= 0.25);  // the calls after passes 1-5 fall within the log's times
+  CHECK(r.seconds == r.log[5].seconds);  // (the summary's time is the log's last)
   // A budget of 0.2 s is spent by the calls after four passes at the latest, whatever the passes take.
   render_params t = p;
   t.spp = 0;
   t.time_budget = 0.2;
   calls = 0;
   render_result timed = render(b->scene, b->bvh, b->lights, t);
-  CHECK(timed.passes <= 4);
-  CHECK(calls == timed.passes);
+  CHECK(timed.passes <= 5);
+  // (After the pass that spends the budget there is no call; where a call itself spends it, that call came after
+  // what turned out to be the last pass.)
+  CHECK(calls >= timed.passes - 1);
+  CHECK(calls <= timed.passes);
 }
 
 TEST_CASE("an oracle interrupted while it learns leaves no frozen model behind", "[passes]") {
