@@ -549,20 +549,16 @@ static void validate_mtl(const std::string& path, std::vector<mtl_material_data>
     stderr_text() << "warning: " << path << ": material" << (bright.size() > 1 ? "s " : " ") << list
                   << (bright.size() > 1 ? " have" : " has") << " Kd + Ks above 1, scaled down to conserve energy\n";
   }
-  if (!ignored_order.empty()) {
+  // One warning naming each keyword with the line of its first appearance.
+  auto first_lines = [&](const char* what, const std::vector<std::string>& order, std::map<std::string, size_t>& line) {
+    if (order.empty()) return;
     stderr_text w;
-    w << "warning: " << path << ": textures other than map_Kd and map_d are not rendered:";
-    for (size_t i = 0; i < ignored_order.size(); i++)
-      w << (i ? ", " : " ") << ignored_order[i] << " (line " << ignored_maps[ignored_order[i]] << ")";
+    w << "warning: " << path << ": " << what << ":";
+    for (size_t i = 0; i < order.size(); i++) w << (i ? ", " : " ") << order[i] << " (line " << line[order[i]] << ")";
     w << "\n";
-  }
-  if (!skipped_order.empty()) {
-    stderr_text w;
-    w << "warning: " << path << ": texture options that are not applied (the texture is used without them):";
-    for (size_t i = 0; i < skipped_order.size(); i++)
-      w << (i ? ", " : " ") << skipped_order[i] << " (line " << skipped_options[skipped_order[i]] << ")";
-    w << "\n";
-  }
+  };
+  first_lines("textures other than map_Kd and map_d are not rendered", ignored_order, ignored_maps);
+  first_lines("texture options that are not applied (the texture is used without them)", skipped_order, skipped_options);
   if (transparent_line > 0)
     stderr_text() << "warning: " << path << ":" << transparent_line
                   << ": dissolve (d below 1 or Tr above 0) is not rendered, surfaces stay opaque; map_d cuts out\n";
