@@ -391,6 +391,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     lp.time_budget = 0;
     lp.reference = nullptr;
     lp.progress = false;
+    lp.notes = false;  // (its own note below says what it does)
     render_result scratch;
     note.emplace(params.notes, "learning the model of --bayes-oracle " + std::to_string(lp.spp) + " spp ...");
     render_with(learn_in, *b, lp, scratch);
