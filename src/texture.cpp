@@ -304,7 +304,7 @@ static int axis_nearest(float f, int n) {
   return k < 0 ? 0 : (k > n - 1 ? n - 1 : k);
 }
 
-vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp) {
+vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp, const char* solid_channel) {
   if (!texture_complete(tex)) return {0, 0, 0};
   int x0, x1, b0, b1;
   float wx, wb;
@@ -312,7 +312,23 @@ vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp) {
   // v counts rows from the bottom: bottom-based row b is image row height - 1 - b.
   axis_footprint(clamp ? clamp01(uv.y) : wrap01(uv.y), tex.height, clamp, b0, b1, wb);
   int y0 = tex.height - 1 - b0, y1 = tex.height - 1 - b1;
-  auto at = [&](int x, int y) { return texel_rgb(tex, size_t(y) * size_t(tex.width) + size_t(x)); };
+  auto index = [&](int x, int y) { return size_t(y) * size_t(tex.width) + size_t(x); };
+  auto at = [&](int x, int y) { return texel_rgb(tex, index(x, y)); };
+  if (solid_channel) {
+    // The image is also the surface's cut-out: its holes' colours (often black) are no colour of the surface, and
+    // blending them in darkened a leaf within half a texel of its edge (a review). Only solid texels are blended,
+    // their weights renormalised; where none of the four is solid, all four as usual.
+    const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
+    const float ws[4] = {(1 - wx) * (1 - wb), wx * (1 - wb), (1 - wx) * wb, wx * wb};
+    vec3f sum = {0, 0, 0};
+    float total = 0;
+    for (int k = 0; k < 4; k++)
+      if (texel_alpha(tex, index(xs[k], ys[k]), *solid_channel) >= 0.5f) {
+        sum += at(xs[k], ys[k]) * ws[k];
+        total += ws[k];
+      }
+    if (total > 0) return sum / total;
+  }
   vec3f lo = at(x0, y0) * (1.0f - wx) + at(x1, y0) * wx;
   vec3f hi = at(x0, y1) * (1.0f - wx) + at(x1, y1) * wx;
   return lo * (1.0f - wb) + hi * wb;

@@ -81,7 +81,9 @@ inline uint64_t texture_bytes(const texture_data& t) { return t.texels8.size() +
 texture_data texture_from_texels8(std::string path, int width, int height, int channels, std::vector<uint8_t> texels);
 
 // Linear RGB at texture coordinate uv (bilinear; repeat wrap, or with clamp the edge texels beyond [0, 1]).
-vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp = false);
+// solid_channel (when given): the texture is also the cut-out mask, read by that channel (texture_transform::channel):
+// only its solid texels are blended.
+vec3f eval_texture_rgb(const texture_data& tex, vec2f uv, bool clamp = false, const char* solid_channel = nullptr);
 // Alpha mask at uv (nearest texel; repeat wrap or clamp): cut-outs keep hard edges and cost one fetch.
 float eval_texture_alpha(const texture_data& tex, vec2f uv, bool clamp = false, char channel = 0);
 

@@ -105,6 +105,27 @@ TEST_CASE("v equal to zero is the bottom row of the image", "[texture]") {
   CHECK(eval_texture_alpha(t, {0.5f, 0.9f}) == 1.0f);
 }
 
+TEST_CASE("a colour image that is also the cut-out blends its solid texels only", "[texture]") {
+  // An RGBA leaf whose holes store black darkened to 0.56 within half a texel of its edge (a review): the holes'
+  // colours are no colour of the surface. Texel 0 white and solid, texel 1 black and a hole, texel 2 grey and solid.
+  temp_dir dir;
+  auto path = write_png(dir, "leaf.png", 3, 1, 4, {255, 255, 255, 255, 0, 0, 0, 0, 188, 188, 188, 255});
+  texture_data t = load_texture(path);
+  const char channel = 0;
+  const float third = 1.0f / 3.0f;
+  CHECK(eval_texture_rgb(t, {0.5f * third, 0.5f}).x == 1.0f);  // a texel centre: itself either way
+  CHECK(eval_texture_rgb(t, {third, 0.5f}).x == Approx(0.5f));  // between white and the hole: blended as usual
+  CHECK(eval_texture_rgb(t, {third, 0.5f}, false, &channel).x == 1.0f);  // the solid one alone
+  CHECK(eval_texture_rgb(t, {0.9f, 0.5f}, false, &channel).x != 1.0f);  // grey blended with white across the seam
+  // Where none of the four is solid, all four as usual (a point the cut-out lets through is never shaded anyway).
+  auto holes = write_png(dir, "holes.png", 2, 1, 4, {255, 255, 255, 0, 0, 0, 0, 0});
+  texture_data h = load_texture(holes);
+  CHECK(eval_texture_rgb(h, {0.5f, 0.5f}, false, &channel).x == Approx(0.5f));
+  // The mask's channel is the material's: by red, texel 1 (black) is a hole and texel 0 solid.
+  const char red = 'r';
+  CHECK(eval_texture_rgb(t, {third, 0.5f}, false, &red).x == 1.0f);
+}
+
 TEST_CASE("bilinear lookup weighs the two nearest texel centres", "[texture]") {
   temp_dir dir;
   auto path = write_png(dir, "ramp.png", 2, 1, 1, {0, 255});  // linear 0 and 1
