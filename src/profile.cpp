@@ -194,7 +194,7 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
     double t_raw = 1 / limit, t_cam_nee = stage_wall(prof_camera) / nee_b;
     double per_nee = double(b.stats.camera_rays) / nee_b;
     if (params.max_depth == 1 && t_cam_nee > 0 && !per_ray && b.stats.camera_rays > 0)
-      line("  with its camera rays the fraction is at most %.2f (%.2f camera rays per NEE sample, each costing %.2f raw "
+      line("  with its camera rays the fraction is at most %.3g (%.2f camera rays per NEE sample, each costing %.2f raw "
            "shadow rays here)\n", t_raw / (t_raw + t_cam_nee), per_nee, t_cam_nee / per_nee / t_raw);
   }
   line("  between-pass learning: %.2f%% of the plain render's time\n", 100 * a.learn_seconds / std::max(a.seconds, 1e-9));

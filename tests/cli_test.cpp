@@ -1183,6 +1183,8 @@ TEST_CASE("a profile counts the camera rays each NEE sample pays for", "[cli]") 
   double fraction = 0, per_nee = 0;
   char paren = 0;
   line >> fraction >> paren >> per_nee;
+  // Printed to 3 significant digits: under ASan (Embree uninstrumented) a camera ray costs hundreds of shadow rays and
+  // two fixed decimals printed 0.00, which failed CI at stop 38.
   CHECK(fraction > 0);
   CHECK(fraction < 1);
   CHECK(per_nee > 3);  // the box covers about a twentieth of the image
