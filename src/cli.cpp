@@ -322,6 +322,15 @@ int run_render(const render_options& o) {
   for (const std::string& out : outputs)
     if (image_format_of(out) == image_format::unknown)
       throw usage_error("output " + out + ": unknown image format (use .exr, .pfm or .png)");
+  if (!o.log.empty()) {
+    // A log named like an image or a scene is a slip (--log ref.exr for --reference ref.exr replaced the reference
+    // with CSV text; a review): refused before anything is written.
+    std::string ext = fs::path(o.log).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (image_format_of(o.log) != image_format::unknown || ext == ".obj" || ext == ".mtl" || ext == ".json")
+      throw usage_error("--log " + o.log + ": the per-pass log is CSV text and would replace a file of that kind; "
+                        "name it .csv (an error reference is given with --reference)");
+  }
   if (animated) {
     // Every per-frame file names its frame with a printf pattern such as out_%04d.exr.
     const std::string how = " (one %d such as out_%04d.exr; a '%' in the name is written %%): ";

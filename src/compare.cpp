@@ -125,17 +125,43 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
       continue;
     }
     double k = double(runs.size());
-    for (size_t i = 0; i < passes; i++) {
-      double t = 0, e = 0;
-      for (const compare_run* r : runs) {
-        const pass_record& p = r->log[std::min(i, r->log.size() - 1)];
-        t += p.seconds;
-        e += p.error.relmse;
-      }
-      st.curve_seconds.push_back(t / k);
+    std::vector<double> times;  // equal time, several runs: the common times of the mean curve
+    if (data.equal_time && runs.size() > 1) {
+      // Runs end at different passes and times: the mean curve averages them at common times (every run's pass
+      // times from the latest first pass to the earliest last one, each run interpolated there as the table's
+      // relMSE is). Averaged by pass index, a pass of a fast run was averaged with one of a slow run 0.5 s later,
+      // and a run that had ended was held at its last value (a review).
+      double from = 0, to = INFINITY;
+      for (const compare_run* r : runs) from = std::max(from, r->log.front().seconds);
+      for (const compare_run* r : runs) to = std::min(to, r->log.back().seconds);
+      for (const compare_run* r : runs)
+        for (const pass_record& p : r->log)
+          if (p.seconds >= from && p.seconds <= to) times.push_back(p.seconds);
+      std::sort(times.begin(), times.end());
+      times.erase(std::unique(times.begin(), times.end()), times.end());
+    }
+    for (double t : times) {
+      double e = 0;
+      for (const compare_run* r : runs) e += relmse_at_time(r->log, t);
+      st.curve_seconds.push_back(t);
       st.curve_relmse.push_back(e / k);
     }
-    st.seconds = st.curve_seconds.back();
+    if (times.empty()) {
+      // Equal spp: every run has the same passes (the same spp); a run cut short by a signal keeps its last one.
+      // (Also runs that share no time: one's first pass ended after another's last, when a signal cut them short.)
+      for (size_t i = 0; i < passes; i++) {
+        double t = 0, e = 0;
+        for (const compare_run* r : runs) {
+          const pass_record& p = r->log[std::min(i, r->log.size() - 1)];
+          t += p.seconds;
+          e += p.error.relmse;
+        }
+        st.curve_seconds.push_back(t / k);
+        st.curve_relmse.push_back(e / k);
+      }
+    }
+    st.seconds = 0;
+    for (const compare_run* r : runs) st.seconds += r->log.back().seconds / k;
     // Each run's relMSE at the end: at exactly the comparison time at equal time (runs stop at different passes past
     // it), which may lie before a run's first pass when the budget is that short.
     auto end_relmse = [&](const compare_run* r) {
@@ -258,6 +284,10 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
          "1/time; the time-to-target column measures it without that assumption.\n";
   s += "- **time to relMSE**: the time from which the sampler's mean curve stays at or below " + base +
        "'s relMSE in the table, interpolated log-log between passes; " + dash + ": not reached.\n";
+  if (p.runs > 1)
+    s += data.equal_time ? "- **mean curve**: the runs' relMSE averaged at common times (each run's pass times, from "
+                           "the latest first pass to the earliest last one; each run interpolated log-log there).\n"
+                         : "- **mean curve**: the runs' relMSE and seconds averaged pass by pass.\n";
   s += "- **seconds**: render wall time (passes and learning), mean over runs; it excludes the setup column (light "
        "tree, regions) and error computation. Every pass is in curves.csv; error_vs_time.svg plots the mean curves.\n";
   s += format("- **images**: `<sampler>.exr` is the render of run 1 (seed %llu); `<sampler>_error.png` shows its "
@@ -309,6 +339,18 @@ void write_comparison(const compare_data& data, const compare_params& p, const i
   failures.attempt([&] { write_file_atomic(out_path(p, curves_file), comparison_csv(data)); });
   failures.attempt([&] { write_file_atomic(out_path(p, plot_file), comparison_svg(data, p)); });
   failures.attempt([&] { write_file_atomic(out_path(p, summary_file), comparison_summary(data, p)); });
+  // Images of samplers this comparison did not run, left by an earlier one in the same folder, look like its results
+  // (a review): named, not removed (they may be wanted).
+  std::string stale;
+  for (sampler_kind k : all_sampler_kinds) {
+    if (std::find(p.samplers.begin(), p.samplers.end(), k) != p.samplers.end()) continue;
+    std::error_code ec;
+    for (const std::string& f : {image_file(p, k), error_file(p, k)})
+      if (fs::exists(f, ec)) stale += (stale.empty() ? "" : ", ") + fs::path(f).filename().string();
+  }
+  if (!stale.empty())
+    std::fprintf(stderr, "compare: warning: %s also holds %s from an earlier comparison (not part of this one)\n",
+                 p.out_dir.c_str(), stale.c_str());
   failures.rethrow();
 }
 

@@ -14,9 +14,6 @@ namespace bl {
 
 namespace {
 
-constexpr sampler_kind all_kinds[] = {sampler_kind::uniform, sampler_kind::power,    sampler_kind::bvh,
-                                      sampler_kind::bound,   sampler_kind::donikian, sampler_kind::bayes};
-
 // Fine region keys of the first hits of rays through every pixel centre (sorted, unique), rows traced in parallel
 // (the sort makes the result independent of the split).
 std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_grid_data& grid) {
@@ -86,7 +83,7 @@ const char* sampler_name(sampler_kind kind) {
 }
 
 bool parse_sampler_kind(const std::string& name, sampler_kind& kind) {
-  for (sampler_kind k : all_kinds)
+  for (sampler_kind k : all_sampler_kinds)
     if (name == sampler_name(k)) {
       kind = k;
       return true;
@@ -96,7 +93,7 @@ bool parse_sampler_kind(const std::string& name, sampler_kind& kind) {
 
 std::string sampler_names() {
   std::string s;
-  for (sampler_kind k : all_kinds) s += std::string(s.empty() ? "" : " | ") + sampler_name(k);
+  for (sampler_kind k : all_sampler_kinds) s += std::string(s.empty() ? "" : " | ") + sampler_name(k);
   return s;
 }
 

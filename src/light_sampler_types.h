@@ -24,6 +24,9 @@ namespace bl {
 
 // The sampler names of the command line, in the order of SPEC.md section 7.
 enum class sampler_kind { uniform, power, bvh, bound, donikian, bayes };
+inline constexpr sampler_kind all_sampler_kinds[] = {sampler_kind::uniform, sampler_kind::power,
+                                                     sampler_kind::bvh,     sampler_kind::bound,
+                                                     sampler_kind::donikian, sampler_kind::bayes};
 // Name of a sampler kind.
 const char* sampler_name(sampler_kind kind);
 // Parses a sampler name; false when unknown.

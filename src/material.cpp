@@ -12,12 +12,9 @@ bsdf_data make_bsdf(const scene_data& scene, const surface_point& sp) {
   bsdf_data b;
   b.kd = m.kd;
   if (m.kd_texture != invalid_id) {
-    // A colour image that is also the cut-out, read at the same uv: blended over its solid texels only.
-    const bool cutout = m.alpha_texture == m.kd_texture && m.alpha_map.scale.x == m.kd_map.scale.x &&
-                        m.alpha_map.scale.y == m.kd_map.scale.y && m.alpha_map.offset.x == m.kd_map.offset.x &&
-                        m.alpha_map.offset.y == m.kd_map.offset.y && m.alpha_map.clamp == m.kd_map.clamp;
+    // A colour image that is also the cut-out (material_data::kd_is_cutout): blended over its solid texels only.
     b.kd = b.kd * eval_texture_rgb(scene.mesh.textures[m.kd_texture], transform_uv(m.kd_map, sp.uv), m.kd_map.clamp,
-                                   cutout ? &m.alpha_map.channel : nullptr);
+                                   m.kd_is_cutout ? &m.alpha_map.channel : nullptr);
   }
   b.ks = m.ks;
   b.ns = std::min(std::max(m.ns, 0.0f), max_phong_exponent);

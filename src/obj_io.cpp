@@ -343,6 +343,8 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
     material_data md = m.material;
     md.kd_texture = texture_index(mesh, loaded, clean.folders, m.mtl_path, m.kd_map_line, "map_Kd", m.kd_map);
     md.alpha_texture = texture_index(mesh, loaded, clean.folders, m.mtl_path, m.alpha_map_line, "map_d", m.alpha_map);
+    md.kd_is_cutout =
+        md.kd_texture != invalid_id && md.alpha_texture == md.kd_texture && same_lookup(md.kd_map, md.alpha_map);
     mesh.materials.push_back(md);
   }
   if (clean.folders.unsaid > 0)

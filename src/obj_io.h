@@ -32,6 +32,9 @@ struct material_data {
   int kd_texture = invalid_id;    // map_Kd: index into mesh_data::textures
   int alpha_texture = invalid_id; // map_d: index into mesh_data::textures
   texture_transform kd_map, alpha_map;  // map_Kd's and map_d's -s, -o and -clamp
+  // map_Kd is also the map_d, read at the same uv (an RGBA leaf): its colour blends the solid texels only, so that
+  // the colour stored in the holes does not darken the edges (set on load from the fields above).
+  bool kd_is_cutout = false;
 };
 
 // A triangle mesh as flat columns; corner c of triangle t is entry 3*t+c of the tri_* corner arrays.

@@ -83,6 +83,10 @@ void check_keys(const desc_context& ctx, const json& obj, const std::string& whe
   }
 }
 
+// Whether an object gives a key a value: a key written as null is left out (its default), as JSON writers emit null
+// for a value not set ("sun": null is no sun). Unknown keys are refused whatever their value (check_keys).
+bool given(const json& obj, const char* key) { return obj.contains(key) && !obj[key].is_null(); }
+
 // A finite number.
 float get_number(const desc_context& ctx, const json& v, const std::string& key) {
   if (!v.is_number()) ctx.fail(key, "\"" + key + "\" must be a number");
@@ -128,7 +132,7 @@ vec3f get_vec3(const desc_context& ctx, const json& v, const std::string& key) {
 
 void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   check_keys(ctx, j, "camera", {"eye", "target", "up", "fov_y_deg"});
-  bool has_eye = j.contains("eye"), has_target = j.contains("target");
+  bool has_eye = given(j, "eye"), has_target = given(j, "target");
   cam.automatic = !has_eye && !has_target;
   cam.frame_eye = has_target && !has_eye;
   cam.frame_target = has_eye && !has_target;
@@ -137,7 +141,7 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   cam.camera_line = ctx.line_of("camera");
   cam.eye_line = has_eye ? ctx.line_of("eye") : 0;
   cam.target_line = has_target ? ctx.line_of("target") : 0;
-  cam.up_given = j.contains("up");
+  cam.up_given = given(j, "up");
   cam.up_line = cam.up_given ? ctx.line_of("up") : 0;
   // Embree refuses ray origins beyond about 1.8e18 (a camera framed from a target-only key sits near its target);
   // no mesh that keeps a triangle reaches 1e17 (float spacing there exceeds any triangle whose area is finite).
@@ -147,8 +151,8 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   };
   within_range(has_eye, cam.eye, "eye");
   within_range(has_target, cam.target, "target");
-  if (j.contains("up")) cam.up = get_vec3(ctx, j["up"], "up");
-  if (j.contains("fov_y_deg")) cam.fov_y_deg = get_number(ctx, j["fov_y_deg"], "fov_y_deg");
+  if (given(j, "up")) cam.up = get_vec3(ctx, j["up"], "up");
+  if (given(j, "fov_y_deg")) cam.fov_y_deg = get_number(ctx, j["fov_y_deg"], "fov_y_deg");
   if (!(cam.fov_y_deg > 0 && cam.fov_y_deg < 179))
     ctx.fail("fov_y_deg", "\"fov_y_deg\" must be in (0, 179) degrees");
   vec3f dir = cam.target - cam.eye;
@@ -161,13 +165,13 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
 
 void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
   check_keys(ctx, j, "sun", {"direction", "irradiance", "angular_diameter_deg", "direction_end"});
-  if (!j.contains("direction") || !j.contains("irradiance"))
+  if (!given(j, "direction") || !given(j, "irradiance"))
     ctx.fail("sun", "\"sun\" needs \"direction\" and \"irradiance\"");
   sun.enabled = true;
   vec3f d = get_vec3(ctx, j["direction"], "direction");
   if (!(length(normalize(d)) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
   sun.direction = normalize(d);
-  if (j.contains("direction_end")) {
+  if (given(j, "direction_end")) {
     vec3f e = get_vec3(ctx, j["direction_end"], "direction_end");
     if (!(length(normalize(e)) > 0)) ctx.fail("direction_end", "sun \"direction_end\" must be a non-zero vector");
     sun.direction_end = normalize(e);
@@ -176,7 +180,7 @@ void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
   sun.irradiance = get_vec3(ctx, j["irradiance"], "irradiance");
   if (sun.irradiance.x < 0 || sun.irradiance.y < 0 || sun.irradiance.z < 0)
     ctx.fail("irradiance", "sun \"irradiance\" must not be negative");
-  if (j.contains("angular_diameter_deg"))
+  if (given(j, "angular_diameter_deg"))
     sun.angular_diameter_deg = get_number(ctx, j["angular_diameter_deg"], "angular_diameter_deg");
   // (180: a half-angle of 90 degrees, the whole sky on the sun's side; a wider disk would reach below the horizon of a
   // surface facing it, which its irradiance could not then describe.)
@@ -265,20 +269,20 @@ scene_desc load_scene_desc(const std::string& path) {
   fs::path mesh = root["mesh"].get<std::string>();
   desc.mesh_path = mesh.is_absolute() ? mesh.string() : (fs::path(path).parent_path() / mesh).string();
 
-  if (root.contains("camera")) parse_camera(ctx, root["camera"], desc.camera);
-  if (root.contains("image")) {
+  if (given(root, "camera")) parse_camera(ctx, root["camera"], desc.camera);
+  if (given(root, "image")) {
     const json& im = root["image"];
     check_keys(ctx, im, "image", {"width", "height"});
     // Each side at most 65536; the pixel count (at most 2^28) is checked once --width and --height have had their say.
-    if (im.contains("width")) desc.width = int(get_integer(ctx, im["width"], "width", 1, max_image_side));
-    if (im.contains("height")) desc.height = int(get_integer(ctx, im["height"], "height", 1, max_image_side));
+    if (given(im, "width")) desc.width = int(get_integer(ctx, im["width"], "width", 1, max_image_side));
+    if (given(im, "height")) desc.height = int(get_integer(ctx, im["height"], "height", 1, max_image_side));
   }
-  if (root.contains("render")) {
+  if (given(root, "render")) {
     const json& r = root["render"];
     check_keys(ctx, r, "render", {"spp", "max_depth", "seed"});
-    if (r.contains("spp")) desc.spp = int(get_integer(ctx, r["spp"], "spp", 1, std::numeric_limits<int>::max()));
-    if (r.contains("max_depth")) desc.max_depth = int(get_integer(ctx, r["max_depth"], "max_depth", 1, 1000));
-    if (r.contains("seed")) {
+    if (given(r, "spp")) desc.spp = int(get_integer(ctx, r["spp"], "spp", 1, std::numeric_limits<int>::max()));
+    if (given(r, "max_depth")) desc.max_depth = int(get_integer(ctx, r["max_depth"], "max_depth", 1, 1000));
+    if (given(r, "seed")) {
       const json& s = r["seed"];
       double d;
       if (whole_float(s, 18446744073709551616.0, d) && d >= 0) {
@@ -290,8 +294,8 @@ scene_desc load_scene_desc(const std::string& path) {
       }
     }
   }
-  if (root.contains("sun")) parse_sun(ctx, root["sun"], desc.sun);
-  if (root.contains("two_sided_emitters")) {
+  if (given(root, "sun")) parse_sun(ctx, root["sun"], desc.sun);
+  if (given(root, "two_sided_emitters")) {
     if (!root["two_sided_emitters"].is_boolean())
       ctx.fail("two_sided_emitters", "\"two_sided_emitters\" must be true or false");
     desc.two_sided_emitters = root["two_sided_emitters"].get<bool>();

@@ -95,6 +95,11 @@ struct texture_transform {
   bool clamp = false;
   char channel = 0;  // map_d's -imfchan: 'r', 'g', 'b', 'm' (the alpha channel) or 'l' (luminance); 0: the default
 };
+// Whether two maps read an image at the same uv (scale, offset and clamp; the channel read may differ).
+inline bool same_lookup(const texture_transform& a, const texture_transform& b) {
+  return a.scale.x == b.scale.x && a.scale.y == b.scale.y && a.offset.x == b.offset.x && a.offset.y == b.offset.y &&
+         a.clamp == b.clamp;
+}
 inline vec2f transform_uv(const texture_transform& t, vec2f uv) {
   return {uv.x * t.scale.x + t.offset.x, uv.y * t.scale.y + t.offset.y};
 }

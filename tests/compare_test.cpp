@@ -316,6 +316,23 @@ TEST_CASE("compare at equal spp writes curves summary plot and images", "[compar
     CHECK(e.path().filename().string().find(".tmp") == std::string::npos);
 }
 
+TEST_CASE("compare names the images an earlier comparison left in its folder", "[compare]") {
+  // A second comparison of fewer samplers into the same folder left the others' images beside a summary that does
+  // not list them, without a word (a review); they are named, and kept.
+  compare_scene s;
+  std::string out = s.dir / "out";
+  std::string args = "compare " + s.json + " --reference " + s.ref + " --spp 2 --out " + out + " --threads 1 --quiet";
+  REQUIRE(run_bayeslight(args + " --samplers uniform,power,bvh").status == 0);
+  run_result r = run_bayeslight(args + " --samplers bvh,uniform");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("compare: warning: " + out + " also holds power.exr, power_error.png from an earlier "
+                      "comparison (not part of this one)") != std::string::npos);
+  CHECK(std::filesystem::exists(out + "/power.exr"));
+  r = run_bayeslight(args + " --samplers power,bvh,uniform");
+  CHECK(r.output.find("warning") == std::string::npos);
+}
+
 TEST_CASE("compare interrupted before any pass keeps an earlier comparison's files", "[compare]") {
   // It rewrote curves.csv (header only), summary.md and the plot over the earlier results (a review). A signal 1 s
   // in reaches bayes's oracle warm-up (far longer than 1 s; set-up takes milliseconds): no pass is complete.
@@ -534,6 +551,35 @@ TEST_CASE("an interrupted equal-time comparison times the first sampler at its l
   d.signal = 0;  // a complete run ends with the first pass past the budget: reached at the budget
   d.samplers[0].runs[0].log.back().seconds = 3.2;
   CHECK(comparison_stats(d)[0].time_to_target == Approx(3.0));
+}
+
+TEST_CASE("at equal time the mean curve averages runs at common times", "[compare]") {
+  // Averaged by pass index, a fast run's pass at 0.53 s was averaged with a slow run's at 0.84 s, and a run that had
+  // ended was held at its last value (a review). Two runs of relMSE 1/t: the mean at any time is 1/t too.
+  compare_data d;
+  d.samplers.resize(1);
+  d.equal_time = true;
+  d.time_budget = 2;
+  for (std::vector<double> times : {std::vector<double>{0.2, 0.5, 1.0, 2.2}, std::vector<double>{0.4, 1.5, 2.1, 2.5}}) {
+    compare_run run;
+    run.spp = int(times.size());
+    for (double t : times) {
+      pass_record p;
+      p.seconds = t;
+      p.has_error = true;
+      p.error.relmse = 1 / t;
+      run.log.push_back(p);
+    }
+    d.samplers[0].runs.push_back(run);
+  }
+  std::vector<compare_stats> st = comparison_stats(d);
+  REQUIRE(st.size() == 1);
+  // From the later first pass (0.4 s) to the earlier last one (2.2 s).
+  CHECK(st[0].curve_seconds == std::vector<double>{0.4, 0.5, 1.0, 1.5, 2.1, 2.2});
+  REQUIRE(st[0].curve_relmse.size() == 6);
+  for (size_t i = 0; i < 6; i++) CHECK(st[0].curve_relmse[i] == Approx(1 / st[0].curve_seconds[i]).epsilon(1e-12));
+  CHECK(st[0].seconds == Approx((2.2 + 2.5) / 2));  // the runs' mean render time
+  CHECK(st[0].relmse == Approx(0.5).epsilon(1e-12));
 }
 
 TEST_CASE("an interrupted equal-time comparison compares the samplers where the shortest run ended", "[compare]") {

@@ -603,6 +603,33 @@ TEST_CASE("one image file named in several ways is decoded once", "[obj]") {
   CHECK(m.materials[3].alpha_texture == 0);
 }
 
+TEST_CASE("a map_Kd that is also the map_d at the same uv is marked as a cut-out colour on load", "[obj]") {
+  // make_bsdf blends such a colour over its solid texels only (texture_test.cpp); the same image read at another
+  // scale, offset or clamp, or a colour without a mask, is an ordinary colour.
+  temp_dir dir;
+  write_png(dir, "leaf.png");
+  write_png(dir, "mask.png");
+  dir.write("l.mtl",
+            "newmtl same\nmap_Kd leaf.png\nmap_d leaf.png\n"
+            "newmtl channel\nmap_Kd leaf.png\nmap_d -imfchan g leaf.png\n"
+            "newmtl scaled\nmap_Kd leaf.png\nmap_d -s 2 1 1 leaf.png\n"
+            "newmtl clamped\nmap_Kd -clamp on leaf.png\nmap_d leaf.png\n"
+            "newmtl other\nmap_Kd leaf.png\nmap_d mask.png\n"
+            "newmtl colour\nmap_Kd leaf.png\n");
+  auto obj = dir.write("l.obj", "mtllib l.mtl\n" + std::string(square_vertices) +
+                                    "vt 0.25 0.5\nusemtl same\nf 1/1 2/1 3/1\nusemtl channel\nf 1/1 3/1 4/1\n"
+                                    "usemtl scaled\nf 1/1 2/1 4/1\nusemtl clamped\nf 2/1 3/1 4/1\n"
+                                    "usemtl other\nf 1/1 2/1 3/1\nusemtl colour\nf 1/1 3/1 4/1\n");
+  mesh_data m = load_obj(obj);
+  REQUIRE(m.materials.size() == 6);
+  CHECK(m.materials[0].kd_is_cutout);
+  CHECK(m.materials[1].kd_is_cutout);  // the mask's channel is the one blended over (eval_texture_rgb)
+  CHECK_FALSE(m.materials[2].kd_is_cutout);
+  CHECK_FALSE(m.materials[3].kd_is_cutout);
+  CHECK_FALSE(m.materials[4].kd_is_cutout);
+  CHECK_FALSE(m.materials[5].kd_is_cutout);
+}
+
 TEST_CASE("library and texture names may be quoted or use Windows separators", "[obj]") {
   // mtllib, map_Kd and map_d resolve names alike: one pair of surrounding double quotes is dropped (a name with a
   // space), and '\\' is tried as '/' when the name as written is not a file.
