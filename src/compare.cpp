@@ -162,6 +162,8 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
     }
     st.seconds = 0;
     for (const compare_run* r : runs) st.seconds += r->log.back().seconds / k;
+    for (const compare_run* r : runs)
+      if (r->run == 1) st.image_relmse = r->log.back().error.relmse;
     // Each run's relMSE at the end: at exactly the comparison time at equal time (runs stop at different passes past
     // it), which may lie before a run's first pass when the budget is that short.
     auto end_relmse = [&](const compare_run* r) {
@@ -209,12 +211,13 @@ std::vector<compare_stats> comparison_stats(const compare_data& data) {
 }
 
 std::string comparison_csv(const compare_data& data) {
-  std::string s = "sampler,run,seed,pass,spp,seconds,relmse,mse\n";
+  // The columns of a render's --log first (a reader of those reads these alike), then the run and its seed.
+  std::string s = "sampler,pass,spp,seconds,relmse,mse,run,seed\n";
   for (const compare_sampler& cs : data.samplers)
     for (const compare_run& r : cs.runs)
       for (const pass_record& p : r.log)
-        s += format("%s,%d,%llu,%d,%d,%.6f,%.9g,%.9g\n", sampler_name(cs.kind), r.run, (unsigned long long)r.seed,
-                    p.pass, p.spp, p.seconds, p.error.relmse, p.error.mse);
+        s += format("%s,%d,%d,%.6f,%.9g,%.9g,%d,%llu\n", sampler_name(cs.kind), p.pass, p.spp, p.seconds,
+                    p.error.relmse, p.error.mse, r.run, (unsigned long long)r.seed);
   return s;
 }
 
@@ -252,13 +255,14 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
   std::string target = stats.empty() || stats[0].runs == 0 ? std::string("?") : format("%.4e", stats[0].relmse);
   s += "| sampler | spp | seconds | relMSE | speed-up vs " + base +
        (data.equal_time ? " (equal time)" : " (efficiency)") +
-       " | time to relMSE " + target + " (s) | setup (s) |\n";
-  s += "|:--|--:|--:|--:|--:|--:|--:|\n";
+       " | time to relMSE " + target + " (s) | setup (s) |" + (data.equal_time ? " image relMSE |\n" : "\n");
+  s += std::string("|:--|--:|--:|--:|--:|--:|--:|") + (data.equal_time ? "--:|\n" : "\n");
   for (size_t i = 0; i < stats.size(); i++) {
     const compare_stats& st = stats[i];
     s += std::string("| ") + sampler_name(data.samplers[i].kind) + " | ";
     if (st.runs == 0) {
-      s += std::string(dash) + " | " + dash + " | " + dash + " | " + dash + " | " + dash + " | " + dash + " |\n";
+      s += std::string(dash) + " | " + dash + " | " + dash + " | " + dash + " | " + dash + " | " + dash + " |";
+      s += data.equal_time ? std::string(" ") + dash + " |\n" : std::string("\n");
       continue;
     }
     s += st.spp_min == st.spp_max ? format("%d", st.spp_max) : format("%d\xe2\x80\x93%d", st.spp_min, st.spp_max);
@@ -266,7 +270,11 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
     if (st.runs > 1) s += format(" \xc2\xb1 %.2e", st.relmse_sd);
     s += std::isfinite(st.speedup) ? format(" | %.2f", st.speedup) : std::string(" | ") + dash;
     s += st.time_to_target >= 0 ? format(" | %.4g", st.time_to_target) : std::string(" | ") + dash;
-    s += format(" | %.3g |\n", st.setup_seconds);
+    s += format(" | %.3g |", st.setup_seconds);
+    if (data.equal_time)
+      s += st.image_relmse >= 0 ? format(" %.4e |\n", st.image_relmse) : std::string(" ") + dash + " |\n";
+    else
+      s += "\n";
   }
 
   s += "\n- **relMSE**: mean over pixels and RGB channels of (x \xe2\x88\x92 r)\xc2\xb2 / (r\xc2\xb2 + 0.01) ";
@@ -274,6 +282,8 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
                          "after it; spp and seconds are the final pass's)"
                        : "after the final pass";
   s += p.runs > 1 ? format("; mean \xc2\xb1 standard deviation over the %d runs.\n", p.runs) : std::string(".\n");
+  if (data.equal_time)
+    s += "- **image relMSE**: the error of `<sampler>.exr`, run 1's render after its last pass (past the budget).\n";
   if (data.equal_time)
     s += "- **speed-up** at equal time: relMSE of " + base + " / relMSE of the sampler, both at the time budget "
          "(each render stops after the first whole pass that reaches it; its error at the budget is interpolated), "

@@ -58,9 +58,10 @@ struct compare_data {
 
 // What summary.md and the plot report for one sampler (error and time of runs that completed a pass).
 struct compare_stats {
-  // Mean curve over runs: point i averages pass i of every run; a run with fewer passes (a --time budget
-  // reached sooner) contributes its final pass, so the last point is the mean of the runs' final passes.
+  // Mean curve over runs: at equal spp point i averages pass i of every run (a run cut short contributes its final
+  // pass); at equal time the runs' relMSE at common times (their pass times within the span all runs cover).
   std::vector<double> curve_seconds, curve_relmse;
+  double image_relmse = -1;          // run 1's final pass: the error of the image written (-1: run 1 has no pass)
   int runs = 0;                      // runs with at least one pass
   int spp_min = 0, spp_max = 0;      // final spp over runs
   double seconds = 0;                // mean final render time

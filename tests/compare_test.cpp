@@ -2,6 +2,7 @@
 // pass, summary.md numbers equal to the CSV's last rows, a well-formed SVG with one path per sampler, images),
 // its exit statuses, and the pieces it is built from (time to a target error, the plot writer, the ramp).
 #include "compare.h"
+#include "metrics.h"
 #include "error_image.h"
 #include "image_io.h"
 #include "svg_plot.h"
@@ -57,7 +58,7 @@ std::vector<csv_row> read_curves(const std::string& path) {
   std::ifstream f(path);
   std::string line;
   std::getline(f, line);
-  CHECK(line == "sampler,run,seed,pass,spp,seconds,relmse,mse");
+  CHECK(line == "sampler,pass,spp,seconds,relmse,mse,run,seed");  // (--log's columns first)
   std::vector<csv_row> rows;
   while (std::getline(f, line)) {
     std::vector<std::string> c;
@@ -65,8 +66,8 @@ std::vector<csv_row> read_curves(const std::string& path) {
     std::string cell;
     while (std::getline(ss, cell, ',')) c.push_back(cell);
     REQUIRE(c.size() == 8);
-    rows.push_back({c[0], std::stoi(c[1]), std::stoi(c[3]), std::stoi(c[4]), std::stoull(c[2]), std::stod(c[5]),
-                    std::stod(c[6]), std::stod(c[7])});
+    rows.push_back({c[0], std::stoi(c[6]), std::stoi(c[1]), std::stoi(c[2]), std::stoull(c[7]), std::stod(c[3]),
+                    std::stod(c[4]), std::stod(c[5])});
   }
   return rows;
 }
@@ -89,7 +90,7 @@ std::map<std::string, std::vector<std::string>> read_summary_table(const std::st
       cells.push_back(cell);
       pos = bar + 1;
     }
-    REQUIRE(cells.size() == 7);
+    REQUIRE((cells.size() == 7 || cells.size() == 8));  // (equal time: the image's relMSE too)
     table[cells[0]] = cells;
   }
   return table;
@@ -412,11 +413,19 @@ TEST_CASE("compare at equal time gives every sampler the same budget", "[compare
   REQUIRE(r.status == 0);
   check_outputs(out, {"bound", "uniform"}, 1, 0.05);
   for (const csv_row& row : read_curves(out + "/curves.csv")) CHECK(row.seconds > 0);
-  std::map<std::string, double> final_seconds;
-  for (const csv_row& row : read_curves(out + "/curves.csv")) final_seconds[row.sampler] = row.seconds;
+  std::map<std::string, double> final_seconds, final_relmse;
+  for (const csv_row& row : read_curves(out + "/curves.csv"))
+    final_seconds[row.sampler] = row.seconds, final_relmse[row.sampler] = row.relmse;
   CHECK(final_seconds["bound"] >= 0.05);
   CHECK(final_seconds["uniform"] >= 0.05);
   CHECK(slurp(out + "/summary.md").find("Equal time: 0.05 s") != std::string::npos);
+  // The last column is the written image's relMSE: its last pass's (the relMSE column is at exactly 0.05 s).
+  auto table = read_summary_table(slurp(out + "/summary.md"));
+  for (const char* k : {"bound", "uniform"}) {
+    REQUIRE(table[k].size() == 8);
+    CHECK(std::stod(table[k][7]) == Approx(final_relmse[k]).epsilon(1e-4));
+    CHECK(std::stod(table[k][7]) == Approx(compute_error(read_image(out + "/" + k + ".exr"), read_image(s.ref)).relmse).epsilon(1e-4));
+  }
 }
 
 TEST_CASE("bad compare invocations exit 2 or 3 and write nothing", "[compare]") {
