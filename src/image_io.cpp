@@ -41,8 +41,8 @@ static void check_input_size(const std::string& path, int64_t w, int64_t h) {
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// PFM: "PF" (RGB) or "Pf" (grey), width, height, scale (< 0: little-endian floats), one whitespace byte, then
-// rows of floats from the bottom row up.
+// PFM: "PF" (RGB) or "Pf" (grey), width, height, scale (< 0: little-endian floats; its magnitude, a brightness
+// scale in some writers, is not applied), one whitespace byte, then rows of floats from the bottom row up.
 
 // True for the whitespace bytes the netpbm header grammar allows.
 static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
@@ -91,8 +91,13 @@ static image_data read_pfm(const std::string& path) {
   if (pos >= b.size() || !is_space(b[pos])) throw input_error(path, "truncated PFM header");
   check_input_size(path, w, h);
   const size_t expected = size_t(w) * size_t(h) * size_t(channels) * 4;
-  ++pos;  // the single whitespace byte that ends the header
-  if (b[pos - 1] == '\r' && b.size() - pos == expected + 1 && b[pos] == '\n') ++pos;  // tolerate CRLF
+  // The single whitespace byte that ends the header; or, when the data then fit exactly, the rest of the scale's
+  // line: blanks and a CRLF or LF ("-1.0 \n" was "1 unexpected bytes after the PFM pixel data"; a review).
+  size_t eol = pos;
+  while (eol < b.size() && (b[eol] == ' ' || b[eol] == '\t')) ++eol;
+  if (eol < b.size() && b[eol] == '\r') ++eol;
+  if (eol < b.size() && b[eol] == '\n') ++eol;
+  pos = eol > pos + 1 && b[eol - 1] == '\n' && b.size() - eol == expected ? eol : pos + 1;
   const size_t found = b.size() - pos;
   if (found < expected)
     throw input_error(path, "truncated PFM data: " + size_text(w, h) + " needs " + std::to_string(expected) +
@@ -270,6 +275,19 @@ static image_data read_exr(const std::string& path) {
       throw input_error(path, "subsampled OpenEXR channels are not supported");
   check_input_size(path, int64_t(h.data_window.max_x) - h.data_window.min_x + 1,
                    int64_t(h.data_window.max_y) - h.data_window.min_y + 1);
+  {
+    // The image is the display window; pixels outside the data window have no value. A data window other than the
+    // display window was read as if it were the image (a 5x3 crop of a 7x5 image was "5x3"; a review).
+    const EXRBox2i &d = h.data_window, &v = h.display_window;
+    if (d.min_x != v.min_x || d.min_y != v.min_y || d.max_x != v.max_x || d.max_y != v.max_y) {
+      auto box = [](const EXRBox2i& b) {
+        return "(" + std::to_string(b.min_x) + ", " + std::to_string(b.min_y) + ")-(" + std::to_string(b.max_x) +
+               ", " + std::to_string(b.max_y) + ")";
+      };
+      throw input_error(path, "OpenEXR data window " + box(d) + " is not the display window " + box(v) +
+                                  " (a cropped or overscanned image; save the whole image)");
+    }
+  }
   for (int c = 0; c < h.num_channels; ++c)
     if (h.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) exr.header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
   // tinyexr 1.0.1 sets num_channels only on success, but on a decoding failure frees the planes up to

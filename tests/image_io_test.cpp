@@ -120,6 +120,21 @@ TEST_CASE("greyscale and big-endian PFM files are read", "[image_io]") {
   CHECK(std::signbit(b.pixels[4]));
 }
 
+TEST_CASE("a PFM scale line may end in blanks and CRLF", "[image_io]") {
+  // "-1.0 \n" was "1 unexpected bytes after the PFM pixel data" (a review). Data whose first bytes are whitespace
+  // codes stay data: the line's end is skipped only where the data then fit exactly.
+  test::temp_dir dir;
+  float first;
+  const uint32_t bits = 0x3f80000au;  // 1.0000012, its first little-endian byte '\n'
+  std::memcpy(&first, &bits, 4);
+  const std::string px = float_bytes(first, true) + float_bytes(2, true) + float_bytes(3, true);
+  for (const char* end : {"\n", "\r\n", " \n", "\t \r\n", " "}) {
+    INFO("scale line end " << int(end[0]) << " of " << std::strlen(end) << " bytes");
+    write_file_atomic(dir / "s.pfm", std::string("PF\n1 1\n-1.0") + end + px);
+    CHECK(read_image(dir / "s.pfm").pixels == std::vector<float>{first, 2, 3});
+  }
+}
+
 TEST_CASE("malformed PFM files are input errors naming the file", "[image_io]") {
   test::temp_dir dir;
   const std::string px = float_bytes(1, true) + float_bytes(2, true) + float_bytes(3, true);
@@ -176,9 +191,11 @@ TEST_CASE("half-float and one-channel EXR files from tinyexr are read", "[image_
 // An uncompressed scanline EXR (OpenEXR 2 layout) of float channels written by hand: planes[c] holds channel
 // names[c]'s w x h values, top row first; names in the alphabetical order OpenEXR stores them. line_order 1
 // (DECREASING_Y) writes the chunks from the bottom row up; the offset table stays in y order. compression is the
-// header's code (the data stay uncompressed: only a reader's check of the header can use it).
+// header's code (the data stay uncompressed: only a reader's check of the header can use it). overscan > 0 makes
+// the display window that many pixels smaller on every side than the data window, < 0 larger.
 static std::string handmade_exr(int w, int h, const std::vector<std::string>& names,
-                                const std::vector<std::vector<float>>& planes, int line_order, int compression = 0) {
+                                const std::vector<std::vector<float>>& planes, int line_order, int compression = 0,
+                                int overscan = 0) {
   auto u32 = [](uint32_t v) { return std::string{char(v), char(v >> 8), char(v >> 16), char(v >> 24)}; };
   auto attr = [&](const std::string& name, const std::string& type, const std::string& data) {
     return name + '\0' + type + '\0' + u32(uint32_t(data.size())) + data;
@@ -187,9 +204,11 @@ static std::string handmade_exr(int w, int h, const std::vector<std::string>& na
   for (const std::string& n : names) channels += n + '\0' + u32(2) + u32(0) + u32(1) + u32(1);  // FLOAT, linear 0
   channels += '\0';
   const std::string box = u32(0) + u32(0) + u32(uint32_t(w - 1)) + u32(uint32_t(h - 1));
+  const std::string display = u32(uint32_t(overscan)) + u32(uint32_t(overscan)) + u32(uint32_t(w - 1 - overscan)) +
+                              u32(uint32_t(h - 1 - overscan));
   std::string header = u32(20000630) + u32(2) + attr("channels", "chlist", channels) +
                        attr("compression", "compression", std::string(1, char(compression))) +
-                       attr("dataWindow", "box2i", box) + attr("displayWindow", "box2i", box) +
+                       attr("dataWindow", "box2i", box) + attr("displayWindow", "box2i", display) +
                        attr("lineOrder", "lineOrder", std::string(1, char(line_order))) +
                        attr("pixelAspectRatio", "float", float_bytes(1, true)) +
                        attr("screenWindowCenter", "v2f", float_bytes(0, true) + float_bytes(0, true)) +
@@ -248,6 +267,11 @@ TEST_CASE("EXR files in any line order, and grey ones with alpha, read as writte
   // Two channels, neither R, G, B nor Y: refused, naming what the file has.
   write_file_atomic(dir / "uv.exr", handmade_exr(w, h, {"U", "V"}, {alpha, lum}, 0));
   CHECK_THAT(read_error(dir / "uv.exr"), Catch::Contains("found: U, V"));
+  // A data window that is not the display window (a crop, an overscan) was read as if it were the image (a review).
+  for (int overscan : {1, -1}) {
+    write_file_atomic(dir / "window.exr", handmade_exr(w, h, {"B", "G", "R"}, bgr, 0, 0, overscan));
+    CHECK_THAT(read_error(dir / "window.exr"), Catch::Contains("is not the display window"));
+  }
 }
 
 TEST_CASE("EXR compressions tinyexr cannot decode are named, not called malformed", "[image_io]") {
