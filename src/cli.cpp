@@ -74,6 +74,7 @@ struct render_options {
   int stop_after_passes = -1;  // testing aid: raise SIGINT after this many passes (0: while the render sets up)
   bool signal_after_last_pass = false;  // testing aid: raise SIGINT once the last pass is done, before the outputs
   int kill_after_passes = 0;  // testing aid: raise SIGKILL right after the checkpoint of this pass
+  int signals_in_first_pass = 0;  // testing aid: raise SIGINT this many times once the first pass's first row is done
   std::vector<std::pair<std::string, std::string>> given;  // options given on the command line: (name, help group)
 };
 
@@ -355,6 +356,8 @@ int run_render(const render_options& o) {
 
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
+  params.finish_first_pass = true;  // (an interrupted render has an image to write)
+  params.signals_in_first_pass = o.signals_in_first_pass;
   warn_after_scene(o, params, {kind});
   if (o.frames > 1 && !(desc.sun.enabled && desc.sun.animated))
     std::fprintf(stderr, "%s: warning: %s, so the %d frames show the same scene (the sun moves to sun.direction_end)\n",
@@ -758,6 +761,9 @@ void add_render_command(CLI::App& app, render_options& o) {
               "testing: raise SIGINT once the last pass is done, before the outputs are written")
       ->group("");
   r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes (0: during set-up)")
+      ->group("");
+  r->add_option("--signals-in-first-pass", o.signals_in_first_pass,
+                "testing: raise SIGINT N times once the first pass's first row is done")
       ->group("");
   r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")
       ->group("");

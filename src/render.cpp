@@ -25,6 +25,7 @@ namespace {
 
 std::atomic<int> g_signal{0};
 std::atomic<int> g_signal_count{0};  // signals received (an output's wait ends on a new one)
+std::atomic<bool> g_first_pass{false};  // a render's first pass that a first signal lets finish is running
 // Where the command stands, for a signal: while setting up (loading the scene, phase_setup; then, in the first
 // render_frames, the light tree, the sampler's regions and a checkpoint's state, phase_render_setup) nothing has been
 // written yet, and a loader deep in a large file would notice a request only once it is done, so the handler ends
@@ -53,7 +54,26 @@ extern "C" void on_interrupt(int sig) {
     _exit(128 + sig);
   }
   g_signal.store(sig);
-  g_signal_count.fetch_add(1);
+  if (g_signal_count.fetch_add(1) == 0 && g_first_pass.load()) {
+    static const char* const lines[3] = {
+        "bayeslight: interrupted (SIGINT) in the first pass: finishing it to write an image (interrupt again to "
+        "stop now, with none)\n",
+        "bayeslight: interrupted (SIGTERM) in the first pass: finishing it to write an image (interrupt again to "
+        "stop now, with none)\n",
+        "bayeslight: interrupted (SIGHUP) in the first pass: finishing it to write an image (interrupt again to "
+        "stop now, with none)\n"};
+    const char* line = lines[sig == SIGTERM ? 1 : sig == SIGHUP ? 2 : 0];
+    size_t len = 0;
+    while (line[len]) len++;
+    ssize_t ignored = write(2, line, len);
+    (void)ignored;
+  }
+}
+
+// Whether a pass must stop: on a signal; in a first pass that may finish (g_first_pass), on a second one.
+bool stop_requested() {
+  if (g_signal.load(std::memory_order_relaxed) == 0) return false;
+  return !g_first_pass.load(std::memory_order_relaxed) || g_signal_count.load(std::memory_order_relaxed) >= 2;
 }
 
 using clock_type = std::chrono::steady_clock;
@@ -102,7 +122,7 @@ constexpr int rows_per_band() {
 // Profile, each row's stages are timed into rows.timers.
 template <bool Profile, class Sampler, class Rows>
 bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, std::vector<double>& pass_sum,
-              Rows& rows, tbb::task_arena& arena, progress_counters& progress) {
+              Rows& rows, tbb::task_arena& arena, progress_counters& progress, int raise_signals = 0) {
   int w = in.camera.width, h = in.camera.height;
   std::atomic<bool> stopped{false};
   // Work items are bands of rows (one row for samplers without a row state shared by several rows): a band's rows
@@ -114,7 +134,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
       for (int b = range.begin(); b < range.end(); b++) {
         auto render_band = [&](auto& sink) {
           for (int y = b * band; y < std::min(h, (b + 1) * band); y++) {
-            if (g_signal.load(std::memory_order_relaxed) != 0) {
+            if (stop_requested()) {
               stopped = true;
               return;
             }
@@ -134,7 +154,8 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
               out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
             }
             if constexpr (Profile) rows.timers[size_t(y)] = tm;
-            progress.rows_done.fetch_add(1, std::memory_order_relaxed);
+            if (progress.rows_done.fetch_add(1, std::memory_order_relaxed) == 0)
+              for (int k = 0; k < raise_signals; k++) std::raise(SIGINT);  // (testing)
           }
         };
         if constexpr (Sampler::learns) {
@@ -211,7 +232,9 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   progress.spp_done = done;
   for (int pass = result.passes; done < target; pass++) {
     if (params.time_budget > 0 && result.seconds >= params.time_budget) break;
-    if (g_signal.load() != 0) {
+    // A first pass that a first signal lets finish (render_params::finish_first_pass).
+    const bool first = params.finish_first_pass && pass == 0 && done == 0;
+    if (g_signal.load() != 0 && !(first && g_signal_count.load() < 2)) {
       result.interrupted = true;
       break;
     }
@@ -225,14 +248,17 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     render_inputs pin = in;
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
+    const int raise = first ? params.signals_in_first_pass : 0;
+    g_first_pass.store(first);
     auto run = [&](const auto& s) {
-      return params.profile ? run_pass<true>(pin, s, done, done + count, pass_sum, rows, arena, progress)
-                            : run_pass<false>(pin, s, done, done + count, pass_sum, rows, arena, progress);
+      return params.profile ? run_pass<true>(pin, s, done, done + count, pass_sum, rows, arena, progress, raise)
+                            : run_pass<false>(pin, s, done, done + count, pass_sum, rows, arena, progress, raise);
     };
     bool complete;
     // A bayes sampler that fell back runs its passes as the power sampler itself: the hot path has none of its code.
     if constexpr (std::is_same_v<Sampler, bayes_sampler>) complete = sampler.fallback ? run(sampler.power) : run(sampler);
     else complete = run(sampler);
+    g_first_pass.store(false);
     if (!complete) {
       result.interrupted = true;
       break;
@@ -392,6 +418,8 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     lp.reference = nullptr;
     lp.progress = false;
     lp.notes = false;  // (its own note below says what it does)
+    lp.finish_first_pass = false;  // (a signal ends the learning at once; the render's own first pass then finishes)
+    lp.signals_in_first_pass = 0;
     render_result scratch;
     note.emplace(params.notes, "learning the model of --bayes-oracle " + std::to_string(lp.spp) + " spp ...");
     render_with(learn_in, *b, lp, scratch);

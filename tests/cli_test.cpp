@@ -579,9 +579,10 @@ TEST_CASE("an output FIFO waits for its reader until a signal ends the wait; one
   // Opening the FIFO blocked (as a FIFO's writer does) but SIGINT/SIGTERM could not end the wait: their handlers set a
   // flag and the open restarted. A checkpoint written to a FIFO whose reader reopens it for each one must still wait.
   tiny_scene s;
-  const std::string fifo = s.dir / "out.pfm";
+  const std::string fifo = s.dir / "out.pfm", log_fifo = s.dir / "log.csv";
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
-  for (const std::string& opt : {" -o " + fifo, " -o " + (s.dir / "a.pfm") + " --log " + fifo}) {
+  REQUIRE(::mkfifo(log_fifo.c_str(), 0600) == 0);
+  for (const std::string& opt : {" -o " + fifo, " -o " + (s.dir / "a.pfm") + " --log " + log_fifo}) {
     std::string cmd = std::string("( ") + BAYESLIGHT_BINARY + " render " + s.json + " --quiet" + opt + " 2>" +
                       (s.dir / "err.txt") + " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo $? )";
     FILE* p = popen(cmd.c_str(), "r");
@@ -1139,6 +1140,28 @@ TEST_CASE("an interrupted render writes the completed passes and exits 130 or 14
     while (std::getline(f, line)) rows++;
     CHECK(rows >= 1);
   }
+}
+
+TEST_CASE("a render interrupted in its first pass finishes it and writes its image; a second signal stops it",
+          "[cli]") {
+  // A signal before the first pass ended left no image at all ("no pass completed"), however soon the pass would have
+  // ended (a review: a check that interrupts a slow scene early expects a file). The testing option raises the
+  // signals once the pass's first row is done.
+  tiny_scene s;
+  const std::string base = "render " + s.json + " --sampler bayes --width 32 --height 24 ";
+  run_result r = run_bayeslight(base + "--spp 64 --signals-in-first-pass 1 -o " + (s.dir / "one.pfm") + " --log " +
+                                (s.dir / "one.csv"));
+  INFO(r.output);
+  CHECK(r.status == 130);
+  CHECK(r.output.find("interrupted (SIGINT) in the first pass: finishing it to write an image") != std::string::npos);
+  REQUIRE(run_bayeslight(base + "--spp 1 --quiet -o " + (s.dir / "ref.pfm")).status == 0);
+  CHECK(read_text(s.dir / "one.pfm") == read_text(s.dir / "ref.pfm"));  // the whole first pass: 1 spp
+  CHECK(read_text(s.dir / "one.csv").find("\nbayes,1,1,") != std::string::npos);
+  r = run_bayeslight(base + "--spp 64 --signals-in-first-pass 2 -o " + (s.dir / "two.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 130);
+  CHECK(r.output.find("no pass completed, no image written") != std::string::npos);
+  CHECK(!exists(s.dir / "two.pfm"));
 }
 
 TEST_CASE("a signal after the last pass still ends the render as interrupted, with every output written", "[cli]") {
