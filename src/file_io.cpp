@@ -107,15 +107,23 @@ static std::atomic<bool> g_fifo_wait_given_up{false};
 
 // Writes all n bytes to a FIFO opened non-blocking: while the pipe is full (its reader holds it open without
 // reading yet), polls every 10 ms; a signal arriving meanwhile ends the wait (returns EINTR and sets interrupted).
-static int write_all_fifo(int fd, const char* data, size_t n, int signals_before, bool& interrupted) {
+static int write_all_fifo(const std::string& path, int fd, const char* data, size_t n, int signals_before,
+                          bool& interrupted) {
   // After a signal ended an earlier wait, a reader that takes nothing for a second is given up too (one that reads
   // keeps the write going).
   auto progress = std::chrono::steady_clock::now();
+  bool said = false;
   while (n > 0) {
     ssize_t k = ::write(fd, data, n);
     if (k < 0) {
       if (errno == EINTR) continue;
       if (errno != EAGAIN && errno != EWOULDBLOCK) return errno;
+      if (!said && !g_fifo_wait_given_up && std::chrono::steady_clock::now() - progress > std::chrono::seconds(1)) {
+        // (A wait without a word looks like a hang; and tests signal once they read this.)
+        stderr_text() << "bayeslight: waiting for the process reading " << path
+                      << " to take the rest (a signal gives up on it)\n";
+        said = true;
+      }
       if (signal_since(signals_before) ||
           (g_fifo_wait_given_up && std::chrono::steady_clock::now() - progress > std::chrono::seconds(1))) {
         interrupted = true;
@@ -143,7 +151,8 @@ static int write_all_fifo(int fd, const char* data, size_t n, int signals_before
 static void write_direct(const std::string& path, const std::string& bytes, bool fifo) {
   int fd = -1;
   const int signals_before = g_fifo_wait_check ? g_fifo_wait_check() : 0;
-  for (;;) {
+  const auto wait_start = std::chrono::steady_clock::now();
+  for (bool said = false;;) {
     fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | (fifo ? O_NONBLOCK : 0));
     if (fd >= 0 || !fifo || errno != ENXIO) break;
     if (g_fifo_wait_given_up)
@@ -151,6 +160,10 @@ static void write_direct(const std::string& path, const std::string& bytes, bool
     if (signal_since(signals_before)) {
       g_fifo_wait_given_up = true;
       throw write_failure(path, "interrupted while waiting for a process to read this FIFO");
+    }
+    if (!said && std::chrono::steady_clock::now() - wait_start > std::chrono::seconds(1)) {
+      stderr_text() << "bayeslight: waiting for a process to read " << path << " (a signal gives up on it)\n";
+      said = true;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
@@ -163,7 +176,7 @@ static void write_direct(const std::string& path, const std::string& bytes, bool
   sigpending(&pending);
   const bool pipe_pending_before = sigismember(&pending, SIGPIPE) == 1;
   bool interrupted = false;
-  int err = fifo ? write_all_fifo(fd, bytes.data(), bytes.size(), signals_before, interrupted)
+  int err = fifo ? write_all_fifo(path, fd, bytes.data(), bytes.size(), signals_before, interrupted)
                  : write_all(fd, bytes.data(), bytes.size());
   if (err == EPIPE && !pipe_pending_before) {
     const timespec now{0, 0};

@@ -523,11 +523,13 @@ TEST_CASE("outputs that would overwrite an input or each other are refused befor
   std::string sc = s.dir / "tex.json";
   std::vector<bad_case> cases = {
       {sc + " --checkpoint " + sc, "would overwrite the scene file"},
-      {sc + " --log " + (s.dir / "tex.obj"), "would overwrite the scene input"},
+      {sc + " --checkpoint " + (s.dir / "tex.obj"), "would overwrite the scene input"},
       {sc + " --checkpoint " + (s.dir / "tex.mtl"), "would overwrite the scene input"},
       {sc + " -o " + (s.dir / "floor.png"), "would overwrite the scene input"},
       {sc + " --reference " + (s.dir / "ref.pfm") + " -o " + (s.dir / "sub/../ref.pfm"), "would overwrite the reference"},
-      {sc + " -o " + (s.dir / "a.pfm") + " --log " + (s.dir / "./a.pfm"), "is also the output"},
+      {sc + " -o " + (s.dir / "a.pfm") + " --checkpoint " + (s.dir / "./a.pfm"), "is also the output"},
+      {sc + " --checkpoint " + (s.dir / "run.csv") + " --log " + (s.dir / "sub/../run.csv"), "is also the"},
+      // (A log named .obj, .mtl, .json or like an image is refused by its name: bad command lines.)
   };
   std::filesystem::create_directory(s.dir / "sub");
   for (const auto& c : cases) {
@@ -574,6 +576,18 @@ TEST_CASE("outputs that would overwrite an input or each other are refused befor
   CHECK(again.status == 0);
 }
 
+// Shell code that waits (up to a minute) until `file` holds `text`: a background render's signal is sent once it has
+// reached the stage under test (after a fixed sleep the signal came too early on a loaded machine or under ASan:
+// during set-up, or the render's first pass; a review). The file must not exist before the render starts.
+static std::string await_text(const std::string& file, const std::string& text) {
+  return "i=0; until grep -qF '" + text + "' " + file + " 2>/dev/null || [ $i -ge 1200 ]; do sleep 0.05; i=$((i+1)); " +
+         "done; ";
+}
+// Likewise until `file` exists.
+static std::string await_file(const std::string& file) {
+  return "i=0; until [ -e " + file + " ] || [ $i -ge 1200 ]; do sleep 0.05; i=$((i+1)); done; ";
+}
+
 TEST_CASE("an output FIFO waits for its reader until a signal ends the wait; one with a reader gets the image",
           "[cli]") {
   // Opening the FIFO blocked (as a FIFO's writer does) but SIGINT/SIGTERM could not end the wait: their handlers set a
@@ -583,8 +597,11 @@ TEST_CASE("an output FIFO waits for its reader until a signal ends the wait; one
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
   REQUIRE(::mkfifo(log_fifo.c_str(), 0600) == 0);
   for (const std::string& opt : {" -o " + fifo, " -o " + (s.dir / "a.pfm") + " --log " + log_fifo}) {
-    std::string cmd = std::string("( ") + BAYESLIGHT_BINARY + " render " + s.json + " --quiet" + opt + " 2>" +
-                      (s.dir / "err.txt") + " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo $? )";
+    std::filesystem::remove(s.dir / "err.txt");
+    std::string cmd = std::string("( timeout -k 10 60 ") + BAYESLIGHT_BINARY + " render " + s.json + " --quiet" + opt +
+                      " 2>" + (s.dir / "err.txt") + " & pid=$!; " +
+                      await_text(s.dir / "err.txt", "waiting for a process to read") +
+                      "kill -INT $pid; wait $pid; echo $? )";
     FILE* p = popen(cmd.c_str(), "r");
     REQUIRE(p);
     char buf[64] = {0};
@@ -663,9 +680,11 @@ TEST_CASE("a FIFO output whose reader closes early or stops reading is a reporte
         std::string::npos);
   CHECK(std::filesystem::exists(s.dir / "a.pfm"));
   // A reader that opens the FIFO and sleeps: SIGTERM ends the blocked write (143), well before the reader's 20 s.
+  std::filesystem::remove(s.dir / "err.txt");
   auto t0 = std::chrono::steady_clock::now();
-  status = shell_status("( (exec 3<" + fifo + "; sleep 20) & reader=$!; " + render +
-                        " & pid=$!; sleep 2; kill -TERM $pid; wait $pid; s=$?; kill $reader; echo $s )");
+  status = shell_status("( (exec 3<" + fifo + "; sleep 20) & reader=$!; timeout -k 10 60 " + render + " & pid=$!; " +
+                        await_text(s.dir / "err.txt", "to take the rest") +
+                        "kill -TERM $pid; wait $pid; s=$?; kill $reader; echo $s )");
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   err = read_text(s.dir / "err.txt");
   INFO(err);
@@ -682,7 +701,9 @@ TEST_CASE("a quiet render interrupted while writing its outputs says what it wro
   REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
   int status = shell_status(std::string("( timeout -k 10 20 ") + BAYESLIGHT_BINARY + " render " + s.json +
                             " --quiet --spp 2 -o " + (s.dir / "a.pfm") + " -o " + fifo + " -o " + (s.dir / "b.png") +
-                            " 2>" + (s.dir / "err.txt") + " & pid=$!; sleep 2; kill -INT $pid; wait $pid; echo $? )");
+                            " 2>" + (s.dir / "err.txt") + " & pid=$!; " +
+                            await_text(s.dir / "err.txt", "waiting for a process to read") +
+                            "kill -INT $pid; wait $pid; echo $? )");
   std::string err = read_text(s.dir / "err.txt");
   INFO(err);
   CHECK(status == 130);
@@ -700,7 +721,8 @@ TEST_CASE("one SIGINT ends every FIFO wait, and the outputs after a failed one a
   int status = shell_status(std::string("( timeout -k 10 20 ") + BAYESLIGHT_BINARY + " render " + s.json +
                             " --quiet --spp 64 --checkpoint " + ck + " --checkpoint-every 0 -o " + fifo + " -o " +
                             (s.dir / "keep.pfm") + " --log " + (s.dir / "l.csv") + " 2>" + (s.dir / "err.txt") +
-                            " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo $? )");
+                            " & pid=$!; " + await_text(s.dir / "err.txt", "waiting for a process to read " + ck) +
+                            "kill -INT $pid; wait $pid; echo $? )");
   std::string err = read_text(s.dir / "err.txt");
   INFO(err);
   CHECK(status == 130);
@@ -731,10 +753,11 @@ TEST_CASE("after a signal ended a FIFO wait, a later FIFO whose reader takes not
   REQUIRE(::mkfifo(f1.c_str(), 0600) == 0);
   REQUIRE(::mkfifo(f2.c_str(), 0600) == 0);
   auto t0 = std::chrono::steady_clock::now();
-  int status = shell_status("( (exec 3<" + f2 + "; sleep 20) & reader=$!; " + BAYESLIGHT_BINARY +
+  int status = shell_status("( (exec 3<" + f2 + "; sleep 20) & reader=$!; timeout -k 10 60 " + BAYESLIGHT_BINARY +
                             " render " + s.json + " --quiet --spp 2 --width 128 --height 128 -o " + f1 + " -o " + f2 +
-                            " -o " + (s.dir / "reg.pfm") + " 2>" + (s.dir / "err.txt") +
-                            " & pid=$!; sleep 1; kill -INT $pid; wait $pid; s=$?; kill $reader; echo $s )");
+                            " -o " + (s.dir / "reg.pfm") + " 2>" + (s.dir / "err.txt") + " & pid=$!; " +
+                            await_text(s.dir / "err.txt", "waiting for a process to read " + f1) +
+                            "kill -INT $pid; wait $pid; s=$?; kill $reader; echo $s )");
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::string err = read_text(s.dir / "err.txt");
   INFO(err);
@@ -1116,11 +1139,13 @@ TEST_CASE("an interrupted render writes the completed passes and exits 130 or 14
   tiny_scene s;
   // SIGHUP (a closed terminal) as SIGTERM: before, it killed the render with nothing written.
   for (const char* sig : {"INT", "TERM", "HUP"}) {
-    std::string out = s.dir / (std::string("int_") + sig + ".pfm"), log = s.dir / "int.csv";
-    // A render far too long to finish, stopped after a second by the signal.
-    std::string cmd = std::string("( ") + BAYESLIGHT_BINARY + " render " + s.json +
+    std::string out = s.dir / (std::string("int_") + sig + ".pfm"), log = s.dir / "int.csv", ck = s.dir / "int.ck";
+    std::filesystem::remove(ck);
+    // A render far too long to finish, stopped by the signal once it has checkpointed a pass.
+    std::string cmd = std::string("( timeout -k 10 120 ") + BAYESLIGHT_BINARY + " render " + s.json +
                       " --sampler bayes --spp 100000000 --width 64 --height 48 --quiet -o " + out + " --log " + log +
-                      " >/dev/null 2>&1 & pid=$!; sleep 1; kill -" + sig + " $pid; wait $pid; echo $? )";
+                      " --checkpoint " + ck + " --checkpoint-every 0 >/dev/null 2>&1 & pid=$!; " + await_file(ck) +
+                      "kill -" + sig + " $pid; wait $pid; echo $? )";
     FILE* p = popen(cmd.c_str(), "r");
     REQUIRE(p);
     char buf[64] = {0};
@@ -1235,7 +1260,8 @@ TEST_CASE("a profile counts the camera rays each NEE sample pays for", "[cli]") 
 
 TEST_CASE("an interrupted profile says so and prints no report", "[cli]") {
   // It printed a table of -nan % and ran the shadow-ray benchmark before exiting 130 (a review).
-  std::string cmd = "timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " profile " +
+  // (4 s: under ASan on a loaded machine 1 s could end before the handlers were installed or the load was done.)
+  std::string cmd = "timeout --preserve-status -s INT 4 " + std::string(BAYESLIGHT_BINARY) + " profile " +
                     source_path("data/cornell/direct.json") + " --width 32 --height 24 --spp 100000000 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   REQUIRE(p);

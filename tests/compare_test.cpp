@@ -335,8 +335,9 @@ TEST_CASE("compare names the images an earlier comparison left in its folder", "
 }
 
 TEST_CASE("compare interrupted before any pass keeps an earlier comparison's files", "[compare]") {
-  // It rewrote curves.csv (header only), summary.md and the plot over the earlier results (a review). A signal 1 s
-  // in reaches bayes's oracle warm-up (far longer than 1 s; set-up takes milliseconds): no pass is complete.
+  // It rewrote curves.csv (header only), summary.md and the plot over the earlier results (a review). A signal 4 s
+  // in reaches bayes's oracle warm-up (endless; set-up takes milliseconds, under ASan on a loaded machine about a
+  // second): no pass is complete.
   compare_scene s;
   std::string out = s.dir / "out";
   std::string args = "compare " + s.json + " --reference " + s.ref + " --samplers bayes,uniform --out " + out +
@@ -346,7 +347,7 @@ TEST_CASE("compare interrupted before any pass keeps an earlier comparison's fil
   for (auto& e : std::filesystem::directory_iterator(out)) before[e.path().string()] = slurp(e.path().string());
   REQUIRE(before.size() >= 5);
   run_result r;
-  FILE* p = popen(("timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " " + args +
+  FILE* p = popen(("timeout --preserve-status -s INT 4 " + std::string(BAYESLIGHT_BINARY) + " " + args +
                    " --spp 2 --bayes-oracle 100000000 2>&1").c_str(), "r");
   REQUIRE(p);
   char buf[4096];
@@ -361,7 +362,7 @@ TEST_CASE("compare interrupted before any pass keeps an earlier comparison's fil
   CHECK(after == before);
   // A folder the interrupted comparison created is not left behind, empty (a review).
   const std::string fresh = s.dir / "fresh/a/b";
-  st = std::system(("timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " compare " + s.json +
+  st = std::system(("timeout --preserve-status -s INT 4 " + std::string(BAYESLIGHT_BINARY) + " compare " + s.json +
                     " --reference " + s.ref + " --samplers bayes --out " + fresh +
                     " --threads 1 --quiet --spp 2 --bayes-oracle 100000000 2>/dev/null").c_str());
   CHECK(WIFEXITED(st));
@@ -370,7 +371,7 @@ TEST_CASE("compare interrupted before any pass keeps an earlier comparison's fil
   // Cut short after uniform's passes, in bayes's warm-up: the summary covers uniform, and the earlier bayes images
   // (which it does not describe) are gone.
   REQUIRE(std::filesystem::exists(out + "/bayes.exr"));
-  p = popen(("timeout --preserve-status -s INT 1 " + std::string(BAYESLIGHT_BINARY) + " compare " + s.json +
+  p = popen(("timeout --preserve-status -s INT 4 " + std::string(BAYESLIGHT_BINARY) + " compare " + s.json +
              " --reference " + s.ref + " --samplers uniform,bayes --out " + out +
              " --threads 1 --quiet --spp 2 --bayes-oracle 100000000 2>&1").c_str(), "r");
   REQUIRE(p);

@@ -8,12 +8,15 @@
 
 #include <sys/wait.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -99,7 +102,9 @@ struct temp_dir {
   temp_dir() {
     char tmpl[] = "/tmp/bayeslight_test_XXXXXX";
     char* p = mkdtemp(tmpl);
-    path = p ? p : "/tmp";
+    // (Never "/tmp" itself on failure: the destructor would remove everything in it; a review.)
+    if (!p) throw std::runtime_error(std::string("mkdtemp failed: ") + std::strerror(errno));
+    path = p;
   }
   ~temp_dir() {
     std::error_code ec;
