@@ -537,6 +537,20 @@ TEST_CASE("at equal spp the first sampler reaches its own mean relMSE at its own
   CHECK(st[1].time_to_target == Approx(2.0));  // (its only point is below the target: reached at its first pass)
 }
 
+// A run of one pass per time in `times` (seconds), each with relMSE c / t.
+static compare_run run_of(const std::vector<double>& times, double c) {
+  compare_run run;
+  run.spp = int(times.size());
+  for (double t : times) {
+    pass_record p;
+    p.seconds = t;
+    p.has_error = true;
+    p.error.relmse = c / t;
+    run.log.push_back(p);
+  }
+  return run;
+}
+
 TEST_CASE("an interrupted equal-time comparison times the first sampler at its last pass, not at the budget",
           "[compare]") {
   compare_data d;
@@ -544,16 +558,7 @@ TEST_CASE("an interrupted equal-time comparison times the first sampler at its l
   d.equal_time = true;
   d.time_budget = 3;
   d.signal = 2;  // SIGINT at 1.5 s: the run's passes end at 0.5, 1.0 and 1.48 s
-  compare_run run;
-  run.spp = 3;
-  for (double t : {0.5, 1.0, 1.48}) {
-    pass_record p;
-    p.seconds = t;
-    p.has_error = true;
-    p.error.relmse = 0.1 / t;
-    run.log.push_back(p);
-  }
-  d.samplers[0].runs.push_back(run);
+  d.samplers[0].runs.push_back(run_of({0.5, 1.0, 1.48}, 0.1));
   std::vector<compare_stats> st = comparison_stats(d);
   REQUIRE(st.size() == 1);
   CHECK(st[0].relmse == Approx(0.1 / 1.48));
@@ -570,18 +575,7 @@ TEST_CASE("at equal time the mean curve averages runs at common times", "[compar
   d.samplers.resize(1);
   d.equal_time = true;
   d.time_budget = 2;
-  for (std::vector<double> times : {std::vector<double>{0.2, 0.5, 1.0, 2.2}, std::vector<double>{0.4, 1.5, 2.1, 2.5}}) {
-    compare_run run;
-    run.spp = int(times.size());
-    for (double t : times) {
-      pass_record p;
-      p.seconds = t;
-      p.has_error = true;
-      p.error.relmse = 1 / t;
-      run.log.push_back(p);
-    }
-    d.samplers[0].runs.push_back(run);
-  }
+  d.samplers[0].runs = {run_of({0.2, 0.5, 1.0, 2.2}, 1), run_of({0.4, 1.5, 2.1, 2.5}, 1)};
   std::vector<compare_stats> st = comparison_stats(d);
   REQUIRE(st.size() == 1);
   // From the later first pass (0.4 s) to the earlier last one (2.2 s).
@@ -600,20 +594,9 @@ TEST_CASE("an interrupted equal-time comparison compares the samplers where the 
   d.equal_time = true;
   d.time_budget = 2;
   d.signal = 2;
-  auto run_of = [](std::vector<double> times) {
-    compare_run run;
-    run.spp = int(times.size());
-    for (double t : times) {
-      pass_record p;
-      p.seconds = t;
-      p.has_error = true;
-      p.error.relmse = 0.1 / t;  // both samplers have the same error at the same time
-      run.log.push_back(p);
-    }
-    return run;
-  };
-  d.samplers[0].runs.push_back(run_of({0.25, 0.5, 1.0, 2.1}));
-  d.samplers[1].runs.push_back(run_of({0.3, 0.6, 0.88}));
+  // Both samplers have the same error at the same time.
+  d.samplers[0].runs.push_back(run_of({0.25, 0.5, 1.0, 2.1}, 0.1));
+  d.samplers[1].runs.push_back(run_of({0.3, 0.6, 0.88}, 0.1));
   CHECK(comparison_time(d) == 0.88);
   std::vector<compare_stats> st = comparison_stats(d);
   REQUIRE(st.size() == 2);
