@@ -326,8 +326,7 @@ int run_render(const render_options& o) {
   if (!o.log.empty()) {
     // A log named like an image or a scene is a slip (--log ref.exr for --reference ref.exr replaced the reference
     // with CSV text; a review): refused before anything is written.
-    std::string ext = fs::path(o.log).extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lower_extension(o.log);
     if (image_format_of(o.log) != image_format::unknown || ext == ".obj" || ext == ".mtl" || ext == ".json")
       throw usage_error("--log " + o.log + ": the per-pass log is CSV text and would replace a file of that kind; "
                         "name it .csv (an error reference is given with --reference)");
@@ -763,7 +762,7 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes (0: during set-up)")
       ->group("");
   r->add_option("--signals-in-first-pass", o.signals_in_first_pass,
-                "testing: raise SIGINT N times once the first pass's first row is done")
+                "testing: raise SIGINT N times once the first pass's first row is done (-N: 0.6 s apart)")
       ->group("");
   r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")
       ->group("");

@@ -296,7 +296,8 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
        "'s relMSE in the table, interpolated log-log between passes; " + dash + ": not reached.\n";
   if (p.runs > 1)
     s += data.equal_time ? "- **mean curve**: the runs' relMSE averaged at common times (each run's pass times, from "
-                           "the latest first pass to the earliest last one; each run interpolated log-log there).\n"
+                           "the latest first pass to the earliest last one; each run interpolated log-log there; runs "
+                           "that share no time, pass by pass).\n"
                          : "- **mean curve**: the runs' relMSE and seconds averaged pass by pass.\n";
   s += "- **seconds**: render wall time (passes and learning), mean over runs; it excludes the setup column (light "
        "tree, regions) and error computation. Every pass is in curves.csv; error_vs_time.svg plots the mean curves.\n";

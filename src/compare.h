@@ -92,7 +92,8 @@ std::vector<compare_stats> comparison_stats(const compare_data& data);
 // it and the next (the first point's time when every point is at or below); -1 when the last point is above.
 double time_to_reach(const std::vector<double>& seconds, const std::vector<double>& relmse, double target);
 
-// curves.csv: header `sampler,run,seed,pass,spp,seconds,relmse,mse`, one row per pass of every run.
+// curves.csv: header `sampler,pass,spp,seconds,relmse,mse,run,seed` (a --log's columns first), one row per pass of
+// every run.
 std::string comparison_csv(const compare_data& data);
 // summary.md: the table of SPEC.md's compare command and notes saying how each column is computed.
 std::string comparison_summary(const compare_data& data, const compare_params& params);

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <climits>
 #include <csignal>
+#include <ctime>
 #include <pthread.h>
 #include <thread>
 #include <optional>
@@ -33,12 +34,29 @@ std::atomic<bool> g_first_pass{false};  // a render's first pass that a first si
 enum phase : int { phase_none, phase_setup, phase_before_render, phase_render_setup, phase_render };
 std::atomic<int> g_phase{phase_none};
 
+// Monotonic nanoseconds (clock_gettime is async-signal-safe).
+int64_t monotonic_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return int64_t(t.tv_sec) * 1000000000 + t.tv_nsec;
+}
+std::atomic<int64_t> g_first_signal_ns{0}, g_last_signal_ns{0};
+
+// Writes a whole line to stderr from a signal handler: write(2) only, one write (a line another thread prints
+// stays whole).
+void signal_safe_line(const char* line) {
+  size_t len = 0;
+  while (line[len]) len++;
+  ssize_t ignored = write(2, line, len);
+  (void)ignored;
+}
+
 extern "C" void on_interrupt(int sig) {
+  const int which = sig == SIGTERM ? 1 : sig == SIGHUP ? 2 : 0;
   int phase = g_phase.load();
   if (phase == phase_setup || phase == phase_render_setup) {
-    // Async-signal-safe: write(2) and _exit(2) only, one write (a line another thread prints stays whole). The
-    // message names the phase: loading the scene, or the render's set-up (light tree, regions, a checkpoint's
-    // state), which takes seconds in a scene of many emitters.
+    // Async-signal-safe: write(2) and _exit(2) only. The message names the phase: loading the scene, or the render's
+    // set-up (light tree, regions, a checkpoint's state), which takes seconds in a scene of many emitters.
     static const char* const lines[2][3] = {
         {"bayeslight: interrupted (SIGINT) while loading the scene; nothing written\n",
          "bayeslight: interrupted (SIGTERM) while loading the scene; nothing written\n",
@@ -46,13 +64,12 @@ extern "C" void on_interrupt(int sig) {
         {"bayeslight: interrupted (SIGINT) while setting up the render; nothing written\n",
          "bayeslight: interrupted (SIGTERM) while setting up the render; nothing written\n",
          "bayeslight: interrupted (SIGHUP) while setting up the render; nothing written\n"}};
-    const char* line = lines[phase == phase_setup ? 0 : 1][sig == SIGTERM ? 1 : sig == SIGHUP ? 2 : 0];
-    size_t len = 0;
-    while (line[len]) len++;
-    ssize_t ignored = write(2, line, len);
-    (void)ignored;
+    signal_safe_line(lines[phase == phase_setup ? 0 : 1][which]);
     _exit(128 + sig);
   }
+  const int64_t now = monotonic_ns();
+  if (g_signal_count.load() == 0) g_first_signal_ns.store(now);
+  g_last_signal_ns.store(now);
   g_signal.store(sig);
   if (g_signal_count.fetch_add(1) == 0 && g_first_pass.load()) {
     static const char* const lines[3] = {
@@ -62,18 +79,17 @@ extern "C" void on_interrupt(int sig) {
         "stop now, with none)\n",
         "bayeslight: interrupted (SIGHUP) in the first pass: finishing it to write an image (interrupt again to "
         "stop now, with none)\n"};
-    const char* line = lines[sig == SIGTERM ? 1 : sig == SIGHUP ? 2 : 0];
-    size_t len = 0;
-    while (line[len]) len++;
-    ssize_t ignored = write(2, line, len);
-    (void)ignored;
+    signal_safe_line(lines[which]);
   }
 }
 
-// Whether a pass must stop: on a signal; in a first pass that may finish (g_first_pass), on a second one.
+// Whether a pass must stop: on a signal; in a first pass that may finish (g_first_pass), on a second one that came
+// at least half a second after the first. (GNU timeout sends its signal twice, to the process and to its group: two
+// deliveries microseconds apart are one request.)
 bool stop_requested() {
   if (g_signal.load(std::memory_order_relaxed) == 0) return false;
-  return !g_first_pass.load(std::memory_order_relaxed) || g_signal_count.load(std::memory_order_relaxed) >= 2;
+  if (!g_first_pass.load(std::memory_order_relaxed)) return true;
+  return g_signal_count.load() >= 2 && g_last_signal_ns.load() - g_first_signal_ns.load() >= 500000000;
 }
 
 using clock_type = std::chrono::steady_clock;
@@ -154,8 +170,11 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
               out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
             }
             if constexpr (Profile) rows.timers[size_t(y)] = tm;
-            if (progress.rows_done.fetch_add(1, std::memory_order_relaxed) == 0)
-              for (int k = 0; k < raise_signals; k++) std::raise(SIGINT);  // (testing)
+            if (progress.rows_done.fetch_add(1, std::memory_order_relaxed) == 0)  // (testing)
+              for (int k = 0; k < std::abs(raise_signals); k++) {
+                if (k > 0 && raise_signals < 0) std::this_thread::sleep_for(std::chrono::milliseconds(600));
+                std::raise(SIGINT);
+              }
           }
         };
         if constexpr (Sampler::learns) {
@@ -232,9 +251,13 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   progress.spp_done = done;
   for (int pass = result.passes; done < target; pass++) {
     if (params.time_budget > 0 && result.seconds >= params.time_budget) break;
-    // A first pass that a first signal lets finish (render_params::finish_first_pass).
+    // A first pass that a signal arriving during it lets finish (render_params::finish_first_pass); one that came
+    // before it (an interrupted oracle's learning, the buffers' preparation) stops the render here, as it stops later
+    // passes.
     const bool first = params.finish_first_pass && pass == 0 && done == 0;
-    if (g_signal.load() != 0 && !(first && g_signal_count.load() < 2)) {
+    g_first_pass.store(first);
+    if (g_signal.load() != 0) {
+      g_first_pass.store(false);
       result.interrupted = true;
       break;
     }
@@ -249,7 +272,6 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
     const int raise = first ? params.signals_in_first_pass : 0;
-    g_first_pass.store(first);
     auto run = [&](const auto& s) {
       return params.profile ? run_pass<true>(pin, s, done, done + count, pass_sum, rows, arena, progress, raise)
                             : run_pass<false>(pin, s, done, done + count, pass_sum, rows, arena, progress, raise);
@@ -259,6 +281,9 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     if constexpr (std::is_same_v<Sampler, bayes_sampler>) complete = sampler.fallback ? run(sampler.power) : run(sampler);
     else complete = run(sampler);
     g_first_pass.store(false);
+    // A signal the first pass finished for ends the render after it, even where that pass was the last (an animation
+    // then stops after this frame; before, it went on to the next frame's first pass).
+    if (first && g_signal.load() != 0) result.interrupted = true;
     if (!complete) {
       result.interrupted = true;
       break;
@@ -437,6 +462,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     result.height = params.height;
     result.setup_seconds = frame == 0 ? setup : 0.0;
     render_params fp = params;
+    fp.finish_first_pass = params.finish_first_pass && frame == 0;  // (a later frame stops at once: earlier ones exist)
     if (!params.frame_references.empty()) fp.reference = params.frame_references[size_t(frame)];
     if (frame > 0) {
       set_sun_direction(lights, animated_sun_direction(scene.sun, frame, frames));
@@ -502,7 +528,10 @@ const char* signal_name(int sig) {
   return sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : sig == SIGHUP ? "SIGHUP" : "signal";
 }
 int interrupt_count() { return g_signal_count.load(); }
-void reset_interrupt() { g_signal.store(0); }
+void reset_interrupt() {
+  g_signal.store(0);
+  g_signal_count.store(0);
+}
 int interrupted_before_render() {
   g_phase.store(phase_before_render);  // until the first render sets up, a signal asks it to stop after its pass
   int sig = g_signal.load();

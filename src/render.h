@@ -40,10 +40,12 @@ struct render_params {
   // times in the image (0: all alike). Fixed in advance, so the weighted mean stays unbiased.
   double pass_weighting = 4;
   bool stratify = true;       // stratified light and BSDF samples at the first vertex (integrator.h)
-  // A first signal during the render's first pass (frame 0, not resumed) lets that pass finish, so that there is an
-  // image to write; a second stops at once. (The render command; compare and profile stop at once.)
+  // A signal arriving during the render's first pass (frame 0, not resumed) lets that pass finish, so that there is an
+  // image to write, and the render then stops; a second one, half a second or more later, stops it at once. (The
+  // render command; compare, profile and the oracle's learning stop at once.)
   bool finish_first_pass = false;
-  int signals_in_first_pass = 0;  // testing: raise SIGINT this many times once the first pass's first row is done
+  // Testing: raise SIGINT this many times once the first pass's first row is done (< 0: -N times, 0.6 s apart).
+  int signals_in_first_pass = 0;
   std::vector<const image_data*> frame_references;  // per frame (overrides `reference` when not empty)
   // Called after every completed pass (last = false) and once when the render ends (last = true), with the state
   // of the completed passes: what a checkpoint saves.

@@ -1182,11 +1182,45 @@ TEST_CASE("a render interrupted in its first pass finishes it and writes its ima
   REQUIRE(run_bayeslight(base + "--spp 1 --quiet -o " + (s.dir / "ref.pfm")).status == 0);
   CHECK(read_text(s.dir / "one.pfm") == read_text(s.dir / "ref.pfm"));  // the whole first pass: 1 spp
   CHECK(read_text(s.dir / "one.csv").find("\nbayes,1,1,") != std::string::npos);
-  r = run_bayeslight(base + "--spp 64 --signals-in-first-pass 2 -o " + (s.dir / "two.pfm"));
+  // Two at once are one request (GNU timeout sends its signal to the process and to its group).
+  r = run_bayeslight(base + "--spp 64 --signals-in-first-pass 2 -o " + (s.dir / "twice.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 130);
+  CHECK(read_text(s.dir / "twice.pfm") == read_text(s.dir / "ref.pfm"));
+  // A second one later stops the pass at once, with nothing to write.
+  r = run_bayeslight(base + "--spp 64 --signals-in-first-pass -2 -o " + (s.dir / "two.pfm"));
   INFO(r.output);
   CHECK(r.status == 130);
   CHECK(r.output.find("no pass completed, no image written") != std::string::npos);
   CHECK(!exists(s.dir / "two.pfm"));
+  // A signal before the first pass (here in the oracle's endless learning) stops the render there: a first pass then
+  // rendered with the half-learned model was checkpointed, and its resume differed from one render (a review).
+  const std::string ck = s.dir / "oracle.ck";
+  int st = std::system(("timeout --preserve-status -s INT 4 " + std::string(BAYESLIGHT_BINARY) + " " + base +
+                        "--spp 8 --bayes-oracle 100000000 --quiet --checkpoint " + ck + " -o " +
+                        (s.dir / "oracle.pfm") + " 2>/dev/null").c_str());
+  CHECK(WIFEXITED(st));
+  CHECK(WEXITSTATUS(st) == 130);
+  CHECK(!exists(ck));
+  CHECK(!exists(s.dir / "oracle.pfm"));
+  // A first pass that is also the last: said as an interrupted render of 1 spp (not "after the last pass").
+  r = run_bayeslight(base + "--spp 1 --signals-in-first-pass 1 -o " + (s.dir / "last.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 130);
+  CHECK(r.output.find("interrupted after 1 spp") != std::string::npos);
+  CHECK(read_text(s.dir / "last.pfm") == read_text(s.dir / "ref.pfm"));
+}
+
+TEST_CASE("one signal stops an animation of one-pass frames after the frame it came in", "[cli]") {
+  // The first pass of every frame let a first signal through: with one pass per frame the loop never saw it, and all
+  // frames were rendered (a review). Only frame 0's first pass finishes for a signal; the animation stops after it.
+  tiny_scene s(", \"sun\": {\"direction\": [0, 1, 0.2], \"direction_end\": [0.3, 1, 0], \"irradiance\": [1, 1, 1]}");
+  run_result r = run_bayeslight("render " + s.json + " --spp 1 --frames 20 --signals-in-first-pass 1 -o " +
+                                (s.dir / "f_%02d.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 130);
+  CHECK(exists(s.dir / "f_00.pfm"));
+  CHECK(!exists(s.dir / "f_01.pfm"));
 }
 
 TEST_CASE("a signal after the last pass still ends the render as interrupted, with every output written", "[cli]") {
