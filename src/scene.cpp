@@ -5,6 +5,7 @@
 #include "texture.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace bl {
@@ -111,8 +112,32 @@ scene_data build_scene(const scene_desc& desc, float aspect) {
   if (!(length(cross(normalize(dir), normalize(s.camera.up))) > 1e-6f)) {
     if (c.up_given)
       throw input_error(desc.path, c.up_line, "camera \"up\" must not be parallel to the viewing direction");
-    throw input_error(desc.path, c.camera_line,
-                      "the default camera \"up\", [0, 1, 0], is parallel to the viewing direction: give an \"up\"");
+    // A view straight down or up along the default up, [0, 1, 0] (a plan view, refused before; a review): the up a
+    // camera looking along -z has once tilted to it, -z looking down and +z looking up.
+    s.camera.up = dir.y < 0 ? vec3f{0, 0, -1} : vec3f{0, 0, 1};
+    stderr_text() << desc.path << (c.camera_line > 0 ? ":" + std::to_string(c.camera_line) : std::string())
+                  << ": warning: the camera looks straight " << (dir.y < 0 ? "down" : "up")
+                  << ", along the default \"up\" [0, 1, 0]: [0, 0, " << (dir.y < 0 ? "-1" : "1")
+                  << "] is taken as up (give \"up\" to choose)\n";
+  }
+  {
+    // A camera whose rays float cannot place to a hundredth of the view's height at its target (5 pixels of 480 rows)
+    // renders a distorted image, or a black one: an eye 1e8 from the origin with a field of view of 5e-6
+    // degrees framing a 10-unit stage wrote zeros without a word (a review). Rounding of the eye's coordinates and
+    // of the ray's direction over the distance to the target.
+    const float dist = length(dir);
+    const double view = 2.0 * double(dist) * std::tan(double(s.camera.fov_y_deg) * M_PI / 360.0);
+    const float far = max_abs_component(s.camera.eye);
+    const double rounding = double(std::nextafter(far, INFINITY) - far) + double(dist) * std::ldexp(1.0, -23);
+    if (!(rounding <= 1e-2 * view)) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    ": warning: the camera's rays are placed only to about %.3g at its target, %.2g of the view's "
+                    "height there (an eye %.3g from the origin, a target %.3g away, a field of view of %.3g degrees): "
+                    "the image will be distorted or black; move the eye nearer and widen \"fov_y_deg\"\n",
+                    rounding, rounding / view, double(far), double(dist), double(s.camera.fov_y_deg));
+      stderr_text() << desc.path << buf;
+    }
   }
   return s;
 }

@@ -87,13 +87,16 @@ void check_keys(const desc_context& ctx, const json& obj, const std::string& whe
 // for a value not set ("sun": null is no sun). Unknown keys are refused whatever their value (check_keys).
 bool given(const json& obj, const char* key) { return obj.contains(key) && !obj[key].is_null(); }
 
-// A finite number.
-float get_number(const desc_context& ctx, const json& v, const std::string& key) {
+// A finite number, in double.
+double get_double(const desc_context& ctx, const json& v, const std::string& key) {
   if (!v.is_number()) ctx.fail(key, "\"" + key + "\" must be a number");
   double d = v.get<double>();
   if (!std::isfinite(d) || std::fabs(d) > 1e30)
     ctx.fail(key, "\"" + key + "\" must be a finite number of magnitude at most 1e30");
-  return float(d);
+  return d;
+}
+float get_number(const desc_context& ctx, const json& v, const std::string& key) {
+  return float(get_double(ctx, v, key));
 }
 
 // Whether v is a float-written whole number (64.0, 1e3: what many JSON writers emit for an integer) of magnitude
@@ -130,6 +133,18 @@ vec3f get_vec3(const desc_context& ctx, const json& v, const std::string& key) {
   return {get_number(ctx, v[0], key), get_number(ctx, v[1], key), get_number(ctx, v[2], key)};
 }
 
+// A direction: three finite numbers, not all zero, normalised in double (a vector of 1e-300s underflowed to zero in
+// float and was called zero; a review). {0, 0, 0} when all are zero.
+vec3f get_direction(const desc_context& ctx, const json& v, const std::string& key) {
+  if (!v.is_array() || v.size() != 3) ctx.fail(key, "\"" + key + "\" must be an array of 3 numbers");
+  double x = get_double(ctx, v[0], key), y = get_double(ctx, v[1], key), z = get_double(ctx, v[2], key);
+  double m = std::max({std::fabs(x), std::fabs(y), std::fabs(z)});
+  if (!(m > 0)) return {0, 0, 0};
+  x /= m, y /= m, z /= m;  // (scaled first: squares of 1e-300 underflow in double too)
+  double len = std::sqrt(x * x + y * y + z * z);
+  return {float(x / len), float(y / len), float(z / len)};
+}
+
 void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   check_keys(ctx, j, "camera", {"eye", "target", "up", "fov_y_deg"});
   bool has_eye = given(j, "eye"), has_target = given(j, "target");
@@ -151,16 +166,20 @@ void parse_camera(const desc_context& ctx, const json& j, camera_params& cam) {
   };
   within_range(has_eye, cam.eye, "eye");
   within_range(has_target, cam.target, "target");
-  if (given(j, "up")) cam.up = get_vec3(ctx, j["up"], "up");
-  if (given(j, "fov_y_deg")) cam.fov_y_deg = get_number(ctx, j["fov_y_deg"], "fov_y_deg");
-  if (!(cam.fov_y_deg > 0 && cam.fov_y_deg < 179))
-    ctx.fail("fov_y_deg", "\"fov_y_deg\" must be in (0, 179) degrees");
+  if (given(j, "up")) cam.up = get_direction(ctx, j["up"], "up");
+  if (given(j, "fov_y_deg")) {
+    // Checked in double, then kept inside the interval in float (178.999999 rounded to 179, 1e-300 to 0; a review).
+    double fov = get_double(ctx, j["fov_y_deg"], "fov_y_deg");
+    if (!(fov > 0 && fov < 179)) ctx.fail("fov_y_deg", "\"fov_y_deg\" must be in (0, 179) degrees");
+    cam.fov_y_deg = std::min(std::max(float(fov), std::numeric_limits<float>::denorm_min()), std::nextafter(179.0f, 0.0f));
+  }
   vec3f dir = cam.target - cam.eye;
   bool both = has_eye && has_target;  // otherwise checked once the mesh bounds are known (scene.cpp)
   if (both && !(length(normalize(dir)) > 0)) ctx.fail("target", "camera \"eye\" and \"target\" must differ");
   if (!(length(normalize(cam.up)) > 0)) ctx.fail("up", "camera \"up\" must be a non-zero vector");
-  if (both && !(length(cross(normalize(dir), normalize(cam.up))) > 1e-6f))
+  if (both && cam.up_given && !(length(cross(normalize(dir), normalize(cam.up))) > 1e-6f))
     ctx.fail("up", "camera \"up\" must not be parallel to the viewing direction");
+  // (A view along the default up is given another up once the camera is complete: build_scene.)
 }
 
 void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
@@ -168,12 +187,12 @@ void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
   if (!given(j, "direction") || !given(j, "irradiance"))
     ctx.fail("sun", "\"sun\" needs \"direction\" and \"irradiance\"");
   sun.enabled = true;
-  vec3f d = get_vec3(ctx, j["direction"], "direction");
-  if (!(length(normalize(d)) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
+  vec3f d = get_direction(ctx, j["direction"], "direction");
+  if (!(length(d) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
   sun.direction = normalize(d);
   if (given(j, "direction_end")) {
-    vec3f e = get_vec3(ctx, j["direction_end"], "direction_end");
-    if (!(length(normalize(e)) > 0)) ctx.fail("direction_end", "sun \"direction_end\" must be a non-zero vector");
+    vec3f e = get_direction(ctx, j["direction_end"], "direction_end");
+    if (!(length(e) > 0)) ctx.fail("direction_end", "sun \"direction_end\" must be a non-zero vector");
     sun.direction_end = normalize(e);
     sun.animated = true;
   }
