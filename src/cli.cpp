@@ -422,6 +422,9 @@ int run_render(const render_options& o) {
       if (setup_signal) std::raise(SIGINT);
       if (o.resume.empty()) return;
       uint64_t measured = decode_checkpoint(resume_bytes, o.resume, fingerprint, params.pass_weighting, r, s);
+      // Decoded: the file's bytes (the size of the sampler's state, 100 MB and more) were held for the whole render
+      // (a review: 343 MB against 222 MB resident).
+      std::string().swap(resume_bytes);
       // The log is one error curve against one reference: rows measured against another one (or none) keep their
       // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
       if (measured != reference_key && !r.log.empty()) {

@@ -57,7 +57,21 @@ void progress_bar::draw(bool final_line) {
   double fraction = target > 0 ? (done + running) / target : (budget > 0 ? elapsed / budget : 0);
   fraction = std::min(std::max(fraction, 0.0), 1.0);
   double remaining = fraction > 0 ? elapsed * (1 - fraction) / fraction : -1;
-  if (target == 0 && budget > 0) remaining = std::max(0.0, budget - elapsed);
+  if (target == 0 && budget > 0) {
+    // The budget's end, or the end of the running pass where that comes later (a pass started before the budget runs
+    // to its end: the bar read "0:00 left" for the whole of a last pass of 28 s; a review), from its rows done.
+    remaining = std::max(0.0, budget - elapsed);
+    const int rows_done = counters_.rows_done.load();
+    const int64_t started = counters_.pass_start_ns.load();
+    if (counters_.pass_spp.load() > 0 && rows_done > 0 && started > 0) {
+      const double in_pass =
+          1e-9 * double(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                            std::chrono::steady_clock::now().time_since_epoch()).count() - started);
+      const double pass_fraction = double(rows_done) / rows;
+      remaining = std::max(remaining, in_pass * (1 - pass_fraction) / pass_fraction);
+    }
+    fraction = elapsed + remaining > 0 ? elapsed / (elapsed + remaining) : 0;
+  }
   const int width = 30;
   int fill = int(fraction * width);
   std::string bar(size_t(fill), '=');

@@ -21,6 +21,7 @@ struct progress_counters {
   std::atomic<int> rows_done{0};        // rows of the running pass
   std::atomic<int> rows{1};
   std::atomic<int> pass_spp{0};         // samples per pixel of the running pass
+  std::atomic<int64_t> pass_start_ns{0}; // when the running pass began (steady_clock nanoseconds)
 };
 
 // A running progress bar; stops and clears its line when destroyed.

@@ -265,6 +265,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     progress.pass = pass + 1;
     progress.pass_spp = count;
     progress.rows_done = 0;
+    progress.pass_start_ns =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(clock_type::now().time_since_epoch()).count();
     auto t0 = clock_type::now();
     // Stratified sets (integrator.h): a set starts with the render and after every change of the sampler's model,
     // so no sample of a set depends on samples its model learned from; a model that stays keeps its set.
