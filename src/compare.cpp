@@ -232,9 +232,10 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
   s += data.equal_time ? format("Equal time: %g s of rendering per sampler and run", rp.time_budget)
                        : format("Equal samples: %d spp per sampler and run", rp.spp);
   s += format(" | %dx%d pixels | max depth %d | ", rp.width, rp.height, rp.max_depth);
+  const uint64_t last_seed = rp.seed + uint64_t(p.runs - 1);  // (consecutive seeds wrap past 2^64 - 1 to 0)
   s += p.runs == 1 ? format("1 run (seed %llu)", (unsigned long long)rp.seed)
-                   : format("%d runs (seeds %llu to %llu)", p.runs, (unsigned long long)rp.seed,
-                            (unsigned long long)(rp.seed + uint64_t(p.runs - 1)));
+                   : format("%d runs (seeds %llu to %llu%s)", p.runs, (unsigned long long)rp.seed,
+                            (unsigned long long)last_seed, last_seed < rp.seed ? ", wrapping past 2^64 - 1 to 0" : "");
   s += rp.threads > 0 ? format(" | %d threads\n\n", rp.threads) : std::string(" | threads: all cores\n\n");
   s += (p.reference_note.empty() ? "reference: " + p.reference_path : p.reference_note) + "\n\n";
   const double t_cmp = comparison_time(data);

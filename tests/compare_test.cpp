@@ -403,6 +403,13 @@ TEST_CASE("compare repeats runs with consecutive seeds and reports mean and devi
   REQUIRE(run_bayeslight("render " + s.json + " --sampler bayes --spp 3 --seed 7 -o " + (s.dir / "b.exr") + " --quiet")
               .status == 0);
   CHECK(bit_identical(read_image(out + "/bayes.exr"), read_image(s.dir / "b.exr")));
+  CHECK(summary.find("3 runs (seeds 7 to 9)") != std::string::npos);
+  // Consecutive seeds from the largest wrap to 0, and the summary says so (it read "seeds 18446744073709551615 to 0").
+  r = run_bayeslight("compare " + s.json + " --reference " + s.ref + " --spp 1 --runs 2 --seed 18446744073709551615 "
+                     "--samplers power --out " + out + " --quiet");
+  REQUIRE(r.status == 0);
+  CHECK(slurp(out + "/summary.md").find("(seeds 18446744073709551615 to 0, wrapping past 2^64 - 1 to 0)") !=
+        std::string::npos);
 }
 
 TEST_CASE("compare at equal time gives every sampler the same budget", "[compare]") {
