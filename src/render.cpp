@@ -68,17 +68,19 @@ extern "C" void on_interrupt(int sig) {
     _exit(128 + sig);
   }
   const int64_t now = monotonic_ns();
-  if (g_signal_count.load() == 0) g_first_signal_ns.store(now);
-  g_last_signal_ns.store(now);
+  int64_t unset = 0;  // (lock-free read-modify-writes: a handler interrupted by another keeps the earliest and latest)
+  g_first_signal_ns.compare_exchange_strong(unset, now);
+  for (int64_t last = g_last_signal_ns.load(); last < now && !g_last_signal_ns.compare_exchange_weak(last, now);) {
+  }
   g_signal.store(sig);
   if (g_signal_count.fetch_add(1) == 0 && g_first_pass.load()) {
     static const char* const lines[3] = {
-        "bayeslight: interrupted (SIGINT) in the first pass: finishing it to write an image (interrupt again to "
-        "stop now, with none)\n",
-        "bayeslight: interrupted (SIGTERM) in the first pass: finishing it to write an image (interrupt again to "
-        "stop now, with none)\n",
-        "bayeslight: interrupted (SIGHUP) in the first pass: finishing it to write an image (interrupt again to "
-        "stop now, with none)\n"};
+        "bayeslight: interrupted (SIGINT) in the first pass: finishing it to write an image (interrupt again, "
+        "half a second or more later, to stop now, with none)\n",
+        "bayeslight: interrupted (SIGTERM) in the first pass: finishing it to write an image (interrupt again, "
+        "half a second or more later, to stop now, with none)\n",
+        "bayeslight: interrupted (SIGHUP) in the first pass: finishing it to write an image (interrupt again, "
+        "half a second or more later, to stop now, with none)\n"};
     signal_safe_line(lines[which]);
   }
 }
@@ -255,12 +257,11 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     // before it (an interrupted oracle's learning, the buffers' preparation) stops the render here, as it stops later
     // passes.
     const bool first = params.finish_first_pass && pass == 0 && done == 0;
-    g_first_pass.store(first);
     if (g_signal.load() != 0) {
-      g_first_pass.store(false);
       result.interrupted = true;
       break;
     }
+    g_first_pass.store(first);
     int count = std::min(pass_size(pass, done, int64_t(in.camera.width) * in.camera.height), target - done);
     progress.pass = pass + 1;
     progress.pass_spp = count;
@@ -445,7 +446,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     lp.reference = nullptr;
     lp.progress = false;
     lp.notes = false;  // (its own note below says what it does)
-    lp.finish_first_pass = false;  // (a signal ends the learning at once; the render's own first pass then finishes)
+    lp.finish_first_pass = false;  // (a signal ends the learning at once, and the render before its first pass)
     lp.signals_in_first_pass = 0;
     render_result scratch;
     note.emplace(params.notes, "learning the model of --bayes-oracle " + std::to_string(lp.spp) + " spp ...");
@@ -533,6 +534,8 @@ int interrupt_count() { return g_signal_count.load(); }
 void reset_interrupt() {
   g_signal.store(0);
   g_signal_count.store(0);
+  g_first_signal_ns.store(0);
+  g_last_signal_ns.store(0);
 }
 int interrupted_before_render() {
   g_phase.store(phase_before_render);  // until the first render sets up, a signal asks it to stop after its pass

@@ -130,11 +130,12 @@ scene_data build_scene(const scene_desc& desc, float aspect) {
     const float far = max_abs_component(s.camera.eye);
     const double rounding = double(std::nextafter(far, INFINITY) - far) + double(dist) * std::ldexp(1.0, -23);
     if (!(rounding <= 1e-2 * view)) {
-      char buf[320];
+      char buf[512];
       std::snprintf(buf, sizeof buf,
                     ": warning: the camera's rays are placed only to about %.3g at its target, %.2g of the view's "
                     "height there (an eye %.3g from the origin, a target %.3g away, a field of view of %.3g degrees): "
-                    "the image will be distorted or black; move the eye nearer and widen \"fov_y_deg\"\n",
+                    "the image will be distorted or black; move the eye nearer and widen \"fov_y_deg\", or move the "
+                    "scene nearer the origin\n",
                     rounding, rounding / view, double(far), double(dist), double(s.camera.fov_y_deg));
       stderr_text() << desc.path << buf;
     }

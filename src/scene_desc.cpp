@@ -133,11 +133,14 @@ vec3f get_vec3(const desc_context& ctx, const json& v, const std::string& key) {
   return {get_number(ctx, v[0], key), get_number(ctx, v[1], key), get_number(ctx, v[2], key)};
 }
 
-// A direction: three finite numbers, not all zero, normalised in double (a vector of 1e-300s underflowed to zero in
-// float and was called zero; a review). {0, 0, 0} when all are zero.
+// A direction: three finite numbers, as float; where float cannot normalise them (1e-300s underflow to zero and were
+// called a zero vector, a review), normalised in double first. {0, 0, 0} when all are zero. (Vectors float can
+// normalise are kept as written: their renders and checkpoints stay those of earlier versions.)
 vec3f get_direction(const desc_context& ctx, const json& v, const std::string& key) {
   if (!v.is_array() || v.size() != 3) ctx.fail(key, "\"" + key + "\" must be an array of 3 numbers");
   double x = get_double(ctx, v[0], key), y = get_double(ctx, v[1], key), z = get_double(ctx, v[2], key);
+  vec3f f = {float(x), float(y), float(z)};
+  if (length(normalize(f)) > 0) return f;
   double m = std::max({std::fabs(x), std::fabs(y), std::fabs(z)});
   if (!(m > 0)) return {0, 0, 0};
   x /= m, y /= m, z /= m;  // (scaled first: squares of 1e-300 underflow in double too)
@@ -188,11 +191,11 @@ void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
     ctx.fail("sun", "\"sun\" needs \"direction\" and \"irradiance\"");
   sun.enabled = true;
   vec3f d = get_direction(ctx, j["direction"], "direction");
-  if (!(length(d) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
+  if (!(length(normalize(d)) > 0)) ctx.fail("direction", "sun \"direction\" must be a non-zero vector");
   sun.direction = normalize(d);
   if (given(j, "direction_end")) {
     vec3f e = get_direction(ctx, j["direction_end"], "direction_end");
-    if (!(length(e) > 0)) ctx.fail("direction_end", "sun \"direction_end\" must be a non-zero vector");
+    if (!(length(normalize(e)) > 0)) ctx.fail("direction_end", "sun \"direction_end\" must be a non-zero vector");
     sun.direction_end = normalize(e);
     sun.animated = true;
   }
