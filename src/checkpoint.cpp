@@ -72,7 +72,7 @@ struct writer {
 
 // Reads what writer wrote; every read is bounds-checked and failures name the file.
 struct reader {
-  const std::string& in;
+  std::string_view in;
   const std::string& path;
   size_t pos = 0;
   [[noreturn]] void fail(const std::string& what) const { throw input_error(path, "corrupt checkpoint: " + what); }
@@ -428,7 +428,8 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
   uint64_t stored;
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
   if (stored != checkpoint_checksum(std::string_view(bytes).substr(0, bytes.size() - 8))) throw input_error(path, "corrupt checkpoint: checksum mismatch");
-  std::string body = bytes.substr(0, bytes.size() - 8);
+  // (A view, not a copy: the copy doubled a resume's peak memory, 180 MB for a 90 MB checkpoint.)
+  const std::string_view body = std::string_view(bytes).substr(0, bytes.size() - 8);
   reader r{body, path, sizeof magic};
   if (r.value<uint32_t>() != version) throw input_error(path, "checkpoint of another bayeslight version");
   if (r.value<uint64_t>() != fingerprint)
