@@ -4,8 +4,10 @@
 #include "checkpoint.h"
 
 #include "errors.h"
+#include "file_io.h"
 #include "rng.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <type_traits>
@@ -50,14 +52,17 @@ struct hasher {
 // Appends plain values and columns to a byte string.
 // Appends to `out`, or (counting) only adds up the bytes it would append: a first pass sizes `out` exactly, so that
 // a checkpoint of hundreds of MB is not copied over and over as it grows (half of its writing time, measured).
+// With a sink, the bytes are passed on in pieces of about 4 MB instead (write_checkpoint), and `sum` hashes them as
+// checkpoint_checksum hashes the whole.
+struct streaming_checksum;
 struct writer {
   std::string out;
   bool counting = false;
   size_t count = 0;
-  void bytes(const void* p, size_t n) {
-    if (counting) count += n;
-    else out.append(static_cast<const char*>(p), n);
-  }
+  const byte_sink* sink = nullptr;
+  streaming_checksum* sum = nullptr;
+  void bytes(const void* p, size_t n);
+  void flush();
   template <class T>
   void value(const T& v) {
     static_assert(std::is_trivially_copyable_v<T>, "plain data only");
@@ -383,6 +388,54 @@ uint64_t checkpoint_checksum(std::string_view body) {
   return h.h;
 }
 
+namespace {
+
+// checkpoint_checksum of bytes given in pieces: the same 8-byte words across piece boundaries, then the length.
+struct streaming_checksum {
+  uint64_t h = hasher{}.h;
+  unsigned char partial[8] = {};
+  size_t held = 0, total = 0;
+  void add(const unsigned char* p, size_t n) {
+    total += n;
+    while (n > 0) {
+      size_t k = std::min(n, 8 - held);
+      std::memcpy(partial + held, p, k);
+      held += k, p += k, n -= k;
+      if (held == 8) {
+        uint64_t w;
+        std::memcpy(&w, partial, 8);
+        h = mix64(h ^ w);
+        held = 0;
+      }
+    }
+  }
+  uint64_t finish() {
+    if (held > 0) {
+      uint64_t w = 0;
+      std::memcpy(&w, partial, held);
+      h = mix64(h ^ w);
+    }
+    return mix64(h ^ total);
+  }
+};
+
+void writer::bytes(const void* p, size_t n) {
+  if (counting) {
+    count += n;
+    return;
+  }
+  out.append(static_cast<const char*>(p), n);
+  if (sink && out.size() >= (size_t(4) << 20)) flush();
+}
+void writer::flush() {
+  if (!sink || out.empty()) return;
+  if (sum) sum->add(reinterpret_cast<const unsigned char*>(out.data()), out.size());
+  (*sink)(out.data(), out.size());
+  out.clear();
+}
+
+}  // namespace
+
 uint64_t reference_hash(const image_data* reference) {
   if (!reference) return 0;
   hasher h;
@@ -391,9 +444,9 @@ uint64_t reference_hash(const image_data* reference) {
   return h.h == 0 ? 1 : h.h;
 }
 
-std::string encode_checkpoint(uint64_t fingerprint, uint64_t reference, const render_result& result,
-                              const light_sampler& sampler) {
-  auto emit = [&](writer& w) {
+// Every field of a checkpoint but the checksum that ends it.
+static void emit_checkpoint(writer& w, uint64_t fingerprint, uint64_t reference, const render_result& result,
+                            const light_sampler& sampler) {
     w.bytes(magic, sizeof magic);
     w.value(version);
     w.value(fingerprint);
@@ -410,15 +463,32 @@ std::string encode_checkpoint(uint64_t fingerprint, uint64_t reference, const re
     w.column(result.film);
     w.value(result.film_weight);
     write_sampler(w, sampler);
-  };
+}
+
+std::string encode_checkpoint(uint64_t fingerprint, uint64_t reference, const render_result& result,
+                              const light_sampler& sampler) {
   writer size;
   size.counting = true;
-  emit(size);
+  emit_checkpoint(size, fingerprint, reference, result, sampler);
   writer w;
   w.out.reserve(size.count + sizeof(uint64_t));
-  emit(w);
+  emit_checkpoint(w, fingerprint, reference, result, sampler);
   w.value(checkpoint_checksum(w.out));
   return w.out;
+}
+
+void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,
+                      const light_sampler& sampler) {
+  write_file_atomic_stream(path, [&](const byte_sink& sink) {
+    streaming_checksum sum;
+    writer w;
+    w.sink = &sink;
+    w.sum = &sum;
+    emit_checkpoint(w, fingerprint, reference, result, sampler);
+    w.flush();
+    const uint64_t checksum = sum.finish();
+    sink(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+  });
 }
 
 uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,

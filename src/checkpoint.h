@@ -31,6 +31,10 @@ uint64_t reference_hash(const image_data* reference);
 // the log's errors were measured against.
 std::string encode_checkpoint(uint64_t fingerprint, uint64_t reference, const render_result& result,
                               const light_sampler& sampler);
+// Writes encode_checkpoint's bytes to path as write_file_atomic does, in pieces (never the whole in memory: a
+// checkpoint write added its size to the process's memory, 100-200 MB in the living room; a review).
+void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,
+                      const light_sampler& sampler);
 // Restores a state written by encode_checkpoint into a freshly built sampler of the same kind and the result;
 // throws input_error naming `path` when the data are malformed or were written for another scene/options.
 // `pass_weighting`: the render's (render_params::pass_weighting), against which the film's weight is checked.

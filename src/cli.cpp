@@ -471,7 +471,7 @@ int run_render(const render_options& o) {
     bool due = std::chrono::duration<double>(now - last_write).count() >= o.checkpoint_every;
     if (!last && !due && r.passes != o.kill_after_passes) return;
     try {
-      write_file_atomic(o.checkpoint, encode_checkpoint(fingerprint, reference_key, r, s));
+      write_checkpoint(o.checkpoint, fingerprint, reference_key, r, s);
     } catch (const output_error& e) {
       if (checkpoint_failure.empty())
         std::fprintf(stderr, "bayeslight: warning: %s; the render %s without it\n", e.what(),

@@ -240,10 +240,16 @@ static std::string rename_target(const std::string& path) {
 }
 
 void write_file_atomic(const std::string& path, const std::string& bytes) {
+  write_file_atomic_stream(path, [&](const byte_sink& sink) { sink(bytes.data(), bytes.size()); });
+}
+
+void write_file_atomic_stream(const std::string& path, const std::function<void(const byte_sink&)>& produce) {
   if (path.empty() || path.back() == '/') throw write_failure(path, "not a file name");
   struct stat st {};
   const bool exists = ::stat(path.c_str(), &st) == 0;
   if (exists && !S_ISREG(st.st_mode)) {
+    std::string bytes;
+    produce([&](const char* data, size_t n) { bytes.append(data, n); });
     write_direct(path, bytes, S_ISFIFO(st.st_mode));
     return;
   }
@@ -253,7 +259,16 @@ void write_file_atomic(const std::string& path, const std::string& bytes) {
   int fd = create_temporary(target, tmp);
   if (fd < 0) throw write_failure(path, reason(errno));
   if (exists) (void)::fchmod(fd, st.st_mode & 07777);  // a replaced file keeps its permissions (best effort)
-  int err = write_all(fd, bytes.data(), bytes.size());
+  int err = 0;  // the first failure; later pieces are dropped
+  try {
+    produce([&](const char* data, size_t n) {
+      if (err == 0) err = write_all(fd, data, n);
+    });
+  } catch (...) {
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    throw;
+  }
   // Delayed-allocation and network file systems may report ENOSPC/EIO only here; EINVAL means no fsync support.
   if (err == 0 && ::fsync(fd) != 0 && errno != EINVAL) err = errno;
   int cerr = close_checked(fd);

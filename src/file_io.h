@@ -4,6 +4,7 @@
 // /dev/full, a pipe) are written directly, never renamed over; their write errors are still reported.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +23,11 @@ std::string read_file(const std::string& path);
 // checks every write, fsyncs and closes it, then renames it over path. A symlink is kept and its target
 // replaced (or created, when it does not exist yet). Throws output_error("cannot write PATH: reason") on any failure.
 void write_file_atomic(const std::string& path, const std::string& bytes);
+// The same for content produced in pieces: `produce` hands each piece to the sink it is given, in order, and the
+// pieces go straight to the temporary file (a checkpoint of gigabytes is never held whole in memory). An existing
+// non-regular destination (a FIFO, a device) gets the pieces joined, as write_file_atomic writes it.
+using byte_sink = std::function<void(const char* data, size_t n)>;
+void write_file_atomic_stream(const std::string& path, const std::function<void(const byte_sink&)>& produce);
 // An existing FIFO given as an output waits for a process to read it (as any writer of a FIFO does), polling this
 // function meanwhile (a count of signals received): when it changes during the wait, a signal arrived and the wait
 // gives up with a write_failure. A signal that came before (an interrupted render writing its passes) does not stop
