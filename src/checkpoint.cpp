@@ -49,16 +49,11 @@ struct hasher {
   }
 };
 
-// Appends plain values and columns to a byte string.
-// Appends to `out`, or (counting) only adds up the bytes it would append: a first pass sizes `out` exactly, so that
-// a checkpoint of hundreds of MB is not copied over and over as it grows (half of its writing time, measured).
-// With a sink, the bytes are passed on in pieces of about 4 MB instead (write_checkpoint), and `sum` hashes them as
-// checkpoint_checksum hashes the whole.
+// Appends plain values and columns to a buffer that goes to a sink in pieces of about 4 MB (write_checkpoint), while
+// `sum` hashes them as checkpoint_checksum hashes the whole.
 struct streaming_checksum;
 struct writer {
   std::string out;
-  bool counting = false;
-  size_t count = 0;
   const byte_sink* sink = nullptr;
   streaming_checksum* sum = nullptr;
   void bytes(const void* p, size_t n);
@@ -420,16 +415,19 @@ struct streaming_checksum {
 };
 
 void writer::bytes(const void* p, size_t n) {
-  if (counting) {
-    count += n;
+  constexpr size_t piece = size_t(4) << 20;
+  if (n >= piece) {  // (a large column goes as it is, not through the buffer)
+    flush();
+    sum->add(static_cast<const unsigned char*>(p), n);
+    (*sink)(static_cast<const char*>(p), n);
     return;
   }
   out.append(static_cast<const char*>(p), n);
-  if (sink && out.size() >= (size_t(4) << 20)) flush();
+  if (out.size() >= piece) flush();
 }
 void writer::flush() {
-  if (!sink || out.empty()) return;
-  if (sum) sum->add(reinterpret_cast<const unsigned char*>(out.data()), out.size());
+  if (out.empty()) return;
+  sum->add(reinterpret_cast<const unsigned char*>(out.data()), out.size());
   (*sink)(out.data(), out.size());
   out.clear();
 }
@@ -463,18 +461,6 @@ static void emit_checkpoint(writer& w, uint64_t fingerprint, uint64_t reference,
     w.column(result.film);
     w.value(result.film_weight);
     write_sampler(w, sampler);
-}
-
-std::string encode_checkpoint(uint64_t fingerprint, uint64_t reference, const render_result& result,
-                              const light_sampler& sampler) {
-  writer size;
-  size.counting = true;
-  emit_checkpoint(size, fingerprint, reference, result, sampler);
-  writer w;
-  w.out.reserve(size.count + sizeof(uint64_t));
-  emit_checkpoint(w, fingerprint, reference, result, sampler);
-  w.value(checkpoint_checksum(w.out));
-  return w.out;
 }
 
 void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,

@@ -27,15 +27,12 @@ uint64_t checkpoint_checksum(std::string_view body);
 // were measured against. Not part of the fingerprint (the reference does not change the image).
 uint64_t reference_hash(const image_data* reference);
 
-// Serialises a completed-pass state: the result so far, the sampler's learned state and the hash of the reference
-// the log's errors were measured against.
-std::string encode_checkpoint(uint64_t fingerprint, uint64_t reference, const render_result& result,
-                              const light_sampler& sampler);
-// Writes encode_checkpoint's bytes to path as write_file_atomic does, in pieces (never the whole in memory: a
-// checkpoint write added its size to the process's memory, 100-200 MB in the living room; a review).
+// Writes a completed-pass state to path as write_file_atomic does: the result so far, the sampler's learned state
+// and the hash of the reference the log's errors were measured against, then a checksum. In pieces, never the whole
+// in memory (each write added its size to the process's memory, 100-200 MB in the living room; a review).
 void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,
                       const light_sampler& sampler);
-// Restores a state written by encode_checkpoint into a freshly built sampler of the same kind and the result;
+// Restores a state written by write_checkpoint into a freshly built sampler of the same kind and the result;
 // throws input_error naming `path` when the data are malformed or were written for another scene/options.
 // `pass_weighting`: the render's (render_params::pass_weighting), against which the film's weight is checked.
 // Returns the stored reference hash.
