@@ -377,12 +377,6 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   return h.h;
 }
 
-uint64_t checkpoint_checksum(std::string_view body) {
-  hasher h;
-  h.bytes(body.data(), body.size());
-  return h.h;
-}
-
 namespace {
 
 // checkpoint_checksum of bytes given in pieces: the same 8-byte words across piece boundaries, then the length.
@@ -434,6 +428,13 @@ void writer::flush() {
 
 }  // namespace
 
+// (What hasher::bytes gives for the whole body in one call.)
+uint64_t checkpoint_checksum(std::string_view body) {
+  streaming_checksum sum;
+  sum.add(reinterpret_cast<const unsigned char*>(body.data()), body.size());
+  return sum.finish();
+}
+
 uint64_t reference_hash(const image_data* reference) {
   if (!reference) return 0;
   hasher h;
@@ -445,22 +446,22 @@ uint64_t reference_hash(const image_data* reference) {
 // Every field of a checkpoint but the checksum that ends it.
 static void emit_checkpoint(writer& w, uint64_t fingerprint, uint64_t reference, const render_result& result,
                             const light_sampler& sampler) {
-    w.bytes(magic, sizeof magic);
-    w.value(version);
-    w.value(fingerprint);
-    w.value(reference);
-    w.value(uint32_t(sampler.index()));
-    w.value(result.width), w.value(result.height), w.value(result.passes), w.value(result.spp), w.value(result.stratum_base);
-    w.value(result.seconds);
-    w.value(result.stats);
-    w.value(uint64_t(result.log.size()));
-    for (const pass_record& p : result.log) {
-      w.value(p.pass), w.value(p.spp), w.value(p.seconds), w.value(uint8_t(p.has_error));
-      w.value(p.error.relmse), w.value(p.error.mse), w.value(p.error.maxabs);
-    }
-    w.column(result.film);
-    w.value(result.film_weight);
-    write_sampler(w, sampler);
+  w.bytes(magic, sizeof magic);
+  w.value(version);
+  w.value(fingerprint);
+  w.value(reference);
+  w.value(uint32_t(sampler.index()));
+  w.value(result.width), w.value(result.height), w.value(result.passes), w.value(result.spp), w.value(result.stratum_base);
+  w.value(result.seconds);
+  w.value(result.stats);
+  w.value(uint64_t(result.log.size()));
+  for (const pass_record& p : result.log) {
+    w.value(p.pass), w.value(p.spp), w.value(p.seconds), w.value(uint8_t(p.has_error));
+    w.value(p.error.relmse), w.value(p.error.mse), w.value(p.error.maxabs);
+  }
+  w.column(result.film);
+  w.value(result.film_weight);
+  write_sampler(w, sampler);
 }
 
 void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,
