@@ -3,6 +3,8 @@
 # high-sample reference, with the speed-up of bayes over bound and over bvh (relMSE ratio at equal time).
 #   tools/eqtable.sh BIN   (env: T seconds per render, W H image size, SCENES, MODES, SAMPLERS, REF_SPP_DIRECT,
 #                           REF_SPP_PATH, REF_SAMPLER; references cached in $(dirname BIN)/ref)
+# A cached reference's name carries a hash of the scene's files and of its golden images in that mode (ref_key.sh):
+# a change to the scene, or one of the renderer that changes images, renders a new reference.
 # References: REF_SAMPLER (default bayes: the lowest-variance unbiased sampler here, so its reference adds the least
 # noise to every measured error; a bvh reference of equal spp has 5-50x its relMSE on the occluded scenes), seed
 # 987654321 (independent of the renders' seeds). That the bayes reference is unbiased is checked by the unit tests
@@ -11,6 +13,7 @@
 set -euo pipefail
 bin=$1
 cd "$(dirname "$0")/.."
+. tools/ref_key.sh
 T=${T:-10}; W=${W:-320}; H=${H:-240}
 SCENES=${SCENES:-"cornell living_room plant_room hall"}; MODES=${MODES:-"direct path"}
 SAMPLERS=${SAMPLERS:-"uniform power bvh bound donikian bayes"}
@@ -27,7 +30,8 @@ for scene in $SCENES; do
   for mode in $MODES; do
     json=data/$scene/$mode.json
     spp=$REF_SPP_DIRECT; [ "$mode" = path ] && spp=$REF_SPP_PATH
-    ref=$refdir/${scene}_${mode}_${W}x${H}_${REF_SAMPLER}_${spp}.exr
+    key=$(ref_key "data/$scene" "${scene}_${mode}_*")
+    ref=$refdir/${scene}_${mode}_${W}x${H}_${REF_SAMPLER}_${spp}_${key}.exr
     if [ ! -f "$ref" ]; then
       echo "reference $ref ($REF_SAMPLER, $spp spp)" >&2
       "$bin" render "$json" --sampler "$REF_SAMPLER" --spp "$spp" --seed 987654321 --width "$W" --height "$H" -o "$ref" --quiet

@@ -1,13 +1,18 @@
 #!/usr/bin/env bash
 # Equal-time relMSE of several samplers on one scene against a cached reference.
 #   tools/eqtime.sh BIN SCENE_JSON SECONDS "uniform power bvh bound bayes" [extra render args]
-# The reference (bvh sampler, REF_SPP spp, its own seed) is cached in build/ref/ keyed by scene, size and depth.
+# The reference (bvh sampler, REF_SPP spp, its own seed) is cached in build/ref/ keyed by the scene's files, the
+# goldens, size, spp and options (tools/ref_key.sh).
 set -euo pipefail
 bin=$1; scene=$2; secs=$3; samplers=$4; shift 4
 extra="$*"
 W=${W:-320}; H=${H:-240}; REF_SPP=${REF_SPP:-1024}; REF_SAMPLER=${REF_SAMPLER:-bvh}
 dir=$(dirname "$bin")/ref; mkdir -p "$dir"
-key=$(echo "$scene $W $H $REF_SPP $REF_SAMPLER $extra" | md5sum | cut -c1-12)
+. "$(dirname "$0")/ref_key.sh"
+# A data/ scene's own goldens; any other scene, every golden (a change of output anywhere renders it again).
+name=$(basename "$(dirname "$scene")"); glob='*'
+[ "$(cd "$(dirname "$scene")/../.." 2>/dev/null && pwd)" = "$ref_key_root" ] && glob="${name}_*"
+key=$(ref_key "$(dirname "$scene")" "$glob" "$(basename "$scene") $W $H $REF_SPP $REF_SAMPLER $extra")
 ref="$dir/$(basename "$(dirname "$scene")")_$(basename "$scene" .json)_$key.exr"
 if [ ! -f "$ref" ]; then
   echo "reference: $REF_SAMPLER $REF_SPP spp -> $ref" >&2

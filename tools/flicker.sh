@@ -2,7 +2,7 @@
 # Temporal coherence (issue 4, the paper's test 4): the living room with the sun moving over N frames
 # (sun.direction_end), rendered by bayes, bound and donikian at equal spp per frame with statistics carried
 # across frames (--frame-decay, default 0.5). Per-frame relMSE against per-frame references (REF_SAMPLER, default
-# bayes for the lowest reference noise, REF_SPP spp, seed 99, rendered frame by frame from scratch, cached in BUILD/ref), and a flicker measure: the mean over frames of |relMSE(f) - relMSE(f-1)|, i.e. how much
+# bayes for the lowest reference noise, REF_SPP spp, seed 99, rendered frame by frame from scratch, cached in BUILD/ref under a key of the scene's files and goldens), and a flicker measure: the mean over frames of |relMSE(f) - relMSE(f-1)|, i.e. how much
 # the error jumps from one frame to the next (the paper's concern: learned distributions that change abruptly).
 #   tools/flicker.sh BIN BUILD    (env: FRAMES default 8, SPP per frame default 16, REF_SPP default 2048, REF_SAMPLER, W, H)
 set -euo pipefail
@@ -16,7 +16,8 @@ sed -e "s#\"living_room.obj\"#\"$dir/living_room.obj\"#" \
     -e 's#"direction": \[\([^]]*\)\],#"direction": [\1], "direction_end": [0.6040, 0.7660, -0.2198],#' \
     "$dir/direct.json" >"$tmp/anim.json"
 grep -q direction_end "$tmp/anim.json" || { echo "flicker: could not make the animated scene" >&2; exit 1; }
-refdir=$build/ref/flicker_${W}x${H}_${frames}f_${ref_sampler}_${ref_spp}
+. tools/ref_key.sh
+refdir=$build/ref/flicker_${W}x${H}_${frames}f_${ref_sampler}_${ref_spp}_$(ref_key data/living_room 'living_room_direct_*')
 if [ ! -f "$refdir/done" ]; then
   mkdir -p "$refdir"
   echo "flicker: rendering references ($frames frames, $ref_sampler, $ref_spp spp) into $refdir" >&2
