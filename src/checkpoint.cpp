@@ -337,9 +337,15 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(scene.sun.angular_diameter_deg), h.value(scene.two_sided_emitters);
   h.value(p.width), h.value(p.height), h.value(p.max_depth), h.value(p.seed), h.value(int(p.sampler.kind));
   h.value(p.stratify);
+  const sampler_kind k = p.sampler.kind;
+  if (p.frames > 1) {
+    // An animation: its frame count and the sun's end (each frame's sun), and, for a learning sampler, how much of
+    // its statistics a frame keeps. (A still's fingerprint is what it was before animations could be resumed.)
+    h.value(p.frames), h.value(scene.sun.animated), h.vec(scene.sun.direction_end);
+    if (k == sampler_kind::bayes || k == sampler_kind::donikian) h.value(p.frame_decay);
+  }
   // Only the options of the sampler in use: a uniform render resumed with another --grid or --bayes-b0 (which
   // cannot change its image) was refused as a different render.
-  const sampler_kind k = p.sampler.kind;
   const bool regions = k == sampler_kind::bound || k == sampler_kind::donikian || k == sampler_kind::bayes;
   // Nor the options the others leave without effect (as the command line's warning names them: a resume with
   // --pass-weighting 8 of a --bayes-oracle render was refused right after the warning said it was ignored; a review).
@@ -445,13 +451,15 @@ uint64_t reference_hash(const image_data* reference) {
 
 // Every field of a checkpoint but the checksum that ends it.
 static void emit_checkpoint(writer& w, uint64_t fingerprint, uint64_t reference, const render_result& result,
-                            const light_sampler& sampler) {
+                            const light_sampler& sampler, int frames) {
   w.bytes(magic, sizeof magic);
   w.value(version);
   w.value(fingerprint);
   w.value(reference);
   w.value(uint32_t(sampler.index()));
-  w.value(result.width), w.value(result.height), w.value(result.passes), w.value(result.spp), w.value(result.stratum_base);
+  w.value(result.width), w.value(result.height);
+  if (frames > 1) w.value(result.frame);  // (an animation's only: a still's checkpoint is as it was)
+  w.value(result.passes), w.value(result.spp), w.value(result.stratum_base);
   w.value(result.seconds);
   w.value(result.stats);
   w.value(uint64_t(result.log.size()));
@@ -465,13 +473,13 @@ static void emit_checkpoint(writer& w, uint64_t fingerprint, uint64_t reference,
 }
 
 void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,
-                      const light_sampler& sampler) {
+                      const light_sampler& sampler, int frames) {
   write_file_atomic_stream(path, [&](const byte_sink& sink) {
     streaming_checksum sum;
     writer w;
     w.sink = &sink;
     w.sum = &sum;
-    emit_checkpoint(w, fingerprint, reference, result, sampler);
+    emit_checkpoint(w, fingerprint, reference, result, sampler, frames);
     w.flush();
     const uint64_t checksum = sum.finish();
     sink(reinterpret_cast<const char*>(&checksum), sizeof checksum);
@@ -479,7 +487,7 @@ void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t re
 }
 
 uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
-                           double pass_weighting, render_result& result, light_sampler& sampler) {
+                           const render_params& params, render_result& result, light_sampler& sampler) {
   if (bytes.size() < sizeof magic + 8 || std::memcmp(bytes.data(), magic, sizeof magic) != 0)
     throw input_error(path, "not a bayeslight checkpoint");
   uint64_t stored;
@@ -495,6 +503,8 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
   if (r.value<uint32_t>() != uint32_t(sampler.index())) r.fail("sampler kind");
   int w = r.value<int>(), hgt = r.value<int>();
   if (w != result.width || hgt != result.height) r.fail("image size");
+  result.frame = params.frames > 1 ? r.value<int>() : 0;
+  if (result.frame < 0 || result.frame >= std::max(1, params.frames)) r.fail("frame");
   result.passes = r.value<int>();
   result.spp = r.value<int>();
   result.stratum_base = r.value<int>();
@@ -531,7 +541,7 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
   read_sampler(r, sampler);  // (before the weight: a frozen oracle model does not adapt)
   // The film's weight is a function of the passes (their spp and the weighting fixed in advance): the same sum, in
   // the same order, as the render's.
-  const double weighting = sampler_adapts(sampler) ? pass_weighting : 0.0;
+  const double weighting = sampler_adapts(sampler) ? params.pass_weighting : 0.0;
   double weight = 0;
   spp = 0;
   for (const pass_record& p : result.log) {

@@ -30,13 +30,14 @@ uint64_t reference_hash(const image_data* reference);
 // Writes a completed-pass state to path as write_file_atomic does: the result so far, the sampler's learned state
 // and the hash of the reference the log's errors were measured against, then a checksum. In pieces, never the whole
 // in memory (each write added its size to the process's memory, 100-200 MB in the living room; a review).
+// `frames`: the render's (render_params::frames); an animation's checkpoint also holds result.frame.
 void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,
-                      const light_sampler& sampler);
+                      const light_sampler& sampler, int frames);
 // Restores a state written by write_checkpoint into a freshly built sampler of the same kind and the result;
 // throws input_error naming `path` when the data are malformed or were written for another scene/options.
-// `pass_weighting`: the render's (render_params::pass_weighting), against which the film's weight is checked.
-// Returns the stored reference hash.
+// `params`: the render's, against whose pass weighting the film's weight is checked and whose frame count bounds
+// an animation's frame. Returns the stored reference hash.
 uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
-                           double pass_weighting, render_result& result, light_sampler& sampler);
+                           const render_params& params, render_result& result, light_sampler& sampler);
 
 }  // namespace bl

@@ -341,8 +341,6 @@ int run_render(const render_options& o) {
     if (!o.reference.empty() && !is_frame_pattern(o.reference))
       throw usage_error("--frames needs a frame pattern in --reference" + how + o.reference);
   }
-  if (o.frames > 1 && (!o.checkpoint.empty() || !o.resume.empty()))
-    throw usage_error("--checkpoint and --resume are not supported with --frames");
   warn_unused_options(o, {kind});
   // Every frame's files (a folder that exists for frame 0 only would fail them after their renders).
   for (int f = 0; f < std::max(1, o.frames); f++) {
@@ -415,16 +413,39 @@ int run_render(const render_options& o) {
   }
 
   uint64_t fingerprint = render_fingerprint(scene, params);
-  const uint64_t reference_key = reference_hash(references.empty() ? nullptr : &references[0]);
+  // Per frame: the hash of the reference a frame's logged errors are measured against (0: none).
+  std::vector<uint64_t> reference_keys;
+  for (int f = 0; f < params.frames; f++)
+    reference_keys.push_back(reference_hash(references.empty() ? nullptr : &references[size_t(f)]));
   const bool setup_signal = o.stop_after_passes == 0;  // (testing: the render's set-up calls restore)
   if (setup_signal || !o.resume.empty())
     params.restore = [&](render_result& r, light_sampler& s) {
       if (setup_signal) std::raise(SIGINT);
       if (o.resume.empty()) return;
-      uint64_t measured = decode_checkpoint(resume_bytes, o.resume, fingerprint, params.pass_weighting, r, s);
+      uint64_t measured = decode_checkpoint(resume_bytes, o.resume, fingerprint, params, r, s);
       // Decoded: the file's bytes (the size of the sampler's state, 100 MB and more) were held for the whole render
       // (a review: 343 MB against 222 MB resident).
       std::string().swap(resume_bytes);
+      const uint64_t reference_key = reference_keys[size_t(r.frame)];
+      // An animation's checkpoint of frame k: frames 0 to k - 1 were written by the render that saved it (they are not
+      // rendered again: frame k needs what they learned, and their state is gone).
+      if (r.frame > 0) {
+        std::string missing;
+        int count = 0;
+        for (int f = 0; f < r.frame; f++)
+          for (const std::string& out : outputs)
+            if (!fs::exists(frame_path(out, f, animated)) && count++ == 0) missing = frame_path(out, f, animated);
+        if (count > 0 || !o.quiet)
+          std::fprintf(stderr, "%s: resuming the animation at frame %d of %d (%s rendered before)%s\n",
+                       o.resume.c_str(), r.frame, params.frames,
+                       r.frame == 1 ? "frame 0 was" : ("frames 0 to " + std::to_string(r.frame - 1) + " were").c_str(),
+                       count == 0 ? ""
+                                  : ("; warning: " + missing +
+                                     (count > 1 ? " and " + std::to_string(count - 1) + " more of those frames' files are"
+                                                : " is") +
+                                     " missing (a frame cannot be rendered alone: render the animation again for it)")
+                                        .c_str());
+      }
       // The log is one error curve against one reference: rows measured against another one (or none) keep their
       // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
       if (measured != reference_key && !r.log.empty()) {
@@ -462,16 +483,22 @@ int run_render(const render_options& o) {
   // A checkpoint that cannot be written (a full disk) is reported and the render goes on: its image is still
   // written, and the exit status is 1 at the end.
   std::string checkpoint_failure;
+  int earlier_passes = 0;  // passes of the frames this run completed before (the testing aids count over frames)
   params.on_pass = [&](const render_result& r, const light_sampler& s, bool last) {
-    if (!last && o.stop_after_passes > 0 && r.passes == o.stop_after_passes) std::raise(SIGINT);
+    const int passes = earlier_passes + r.passes;
+    if (!last && o.stop_after_passes > 0 && passes == o.stop_after_passes) std::raise(SIGINT);
     if (last && o.signal_after_last_pass) std::raise(SIGINT);
-    // A render stopped before its first pass has nothing to save: a checkpoint already there is kept.
+    // A render stopped before its first pass has nothing to save: a checkpoint already there is kept (an
+    // animation's frame k stopped so: the checkpoint of frame k - 1's end, from which it resumes).
     if (o.checkpoint.empty() || r.passes == 0) return;
     auto now = std::chrono::steady_clock::now();
     bool due = std::chrono::duration<double>(now - last_write).count() >= o.checkpoint_every;
-    if (!last && !due && r.passes != o.kill_after_passes) return;
+    // The end of the render is always saved; an animation's other frame ends only when due (100 short frames
+    // wrote 100 checkpoints in a few seconds).
+    bool end = last && (r.frame == params.frames - 1 || r.interrupted || interrupt_signal() != 0);
+    if (!end && !due && passes != o.kill_after_passes) return;
     try {
-      write_checkpoint(o.checkpoint, fingerprint, reference_key, r, s);
+      write_checkpoint(o.checkpoint, fingerprint, reference_keys[size_t(r.frame)], r, s, params.frames);
     } catch (const output_error& e) {
       if (checkpoint_failure.empty())
         std::fprintf(stderr, "bayeslight: warning: %s; the render %s without it\n", e.what(),
@@ -479,14 +506,17 @@ int run_render(const render_options& o) {
       checkpoint_failure = e.what();
     }
     last_write = now;
-    if (!last && o.kill_after_passes > 0 && r.passes == o.kill_after_passes) std::raise(SIGKILL);
+    if (!last && o.kill_after_passes > 0 && passes == o.kill_after_passes) std::raise(SIGKILL);
   };
 
   if (int status = interrupted_before_render()) return status;
   bool interrupted = false;
   output_failures failures;  // every output is tried (and every frame rendered) whatever failed before it
   failures.say_now = params.frames > 1;
+  int last_frame = -1;  // the last frame whose outputs were written
   render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
+    earlier_passes += result.passes;
+    last_frame = frame;
     std::vector<std::string> files;
     // (A 4096^2 EXR takes seconds to compress and write after the bar has reached its end.)
     std::optional<slow_phase_note> writing;
@@ -516,7 +546,11 @@ int run_render(const render_options& o) {
   // A signal that came after the last pass (while the outputs were written) still ends the run as interrupted.
   if (interrupted || interrupt_signal() != 0) {
     int sig = interrupt_signal();
-    if (!interrupted)
+    if (!interrupted && last_frame + 1 < params.frames)  // (between an animation's frames)
+      std::fprintf(stderr, "bayeslight: interrupted (%s) after frame %d; frames %d to %d were not rendered%s\n",
+                   signal_name(sig), last_frame, last_frame + 1, params.frames - 1,
+                   o.checkpoint.empty() ? "" : ("; --resume " + o.checkpoint + " renders them").c_str());
+    else if (!interrupted)
       std::fprintf(stderr, "bayeslight: interrupted (%s) after the last pass; every output was written\n",
                    signal_name(sig));
     return 128 + (sig != 0 ? sig : SIGINT);
@@ -747,7 +781,7 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--frames", o.frames,
                 "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
                 "and --reference then take a frame pattern such as out_%04d.exr (default output SCENE_%04d.exr; "
-                "without --frames names are literal)")
+                "without --frames names are literal; with --checkpoint, --resume continues at the frame under way)")
       ->check(CLI::Range(1, 100000));
   r->add_option("--checkpoint", o.checkpoint,
                 "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
@@ -762,12 +796,12 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_flag("--signal-after-last-pass", o.signal_after_last_pass,
               "testing: raise SIGINT once the last pass is done, before the outputs are written")
       ->group("");
-  r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes (0: during set-up)")
+  r->add_option("--stop-after-passes", o.stop_after_passes, "testing: raise SIGINT after N passes, counted over frames (0: during set-up)")
       ->group("");
   r->add_option("--signals-in-first-pass", o.signals_in_first_pass,
                 "testing: raise SIGINT N times once the first pass's first row is done (-N: 0.6 s apart)")
       ->group("");
-  r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N")
+  r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N, counted over frames")
       ->group("");
   r->add_option("--frame-decay", o.frame_decay,
                 "Animations: learned statistics are scaled by this at each new frame (default 0.5; 1 keeps all)")

@@ -459,18 +459,19 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
       b->frozen = true;
   }
   double setup = seconds_since(t0);
-  for (int frame = 0; frame < frames; frame++) {
-    render_result result = frame == 0 && resuming ? restored : render_result{};
+  // A checkpoint of frame k (an animation's) holds the sampler as frame k had it: its decay is in the statistics.
+  const int first = resuming ? restored.frame : 0;
+  for (int frame = first; frame < frames; frame++) {
+    render_result result = frame == first && resuming ? restored : render_result{};
     result.width = params.width;
     result.height = params.height;
-    result.setup_seconds = frame == 0 ? setup : 0.0;
+    result.frame = frame;
+    result.setup_seconds = frame == first ? setup : 0.0;
     render_params fp = params;
     fp.finish_first_pass = params.finish_first_pass && frame == 0;  // (a later frame stops at once: earlier ones exist)
     if (!params.frame_references.empty()) fp.reference = params.frame_references[size_t(frame)];
-    if (frame > 0) {
-      set_sun_direction(lights, animated_sun_direction(scene.sun, frame, frames));
-      std::visit([&](auto& s) { s.begin_frame(params.frame_decay); }, sampler);
-    }
+    if (frame > 0) set_sun_direction(lights, animated_sun_direction(scene.sun, frame, frames));
+    if (frame > first) std::visit([&](auto& s) { s.begin_frame(params.frame_decay); }, sampler);
     std::function<void()> after_pass;
     if (params.on_pass) after_pass = [&] { params.on_pass(result, sampler, false); };
     // Each frame has its own random streams (frame 0 the render's seed): with the same streams in every frame, a
@@ -490,6 +491,12 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     }
     on_frame(frame, result);
     if (result.interrupted) return;
+    // A signal while this frame's outputs were written stops the animation here, and its end is saved (on_pass's
+    // last call again): frame k + 1 would stop before its first pass, leaving nothing to resume from.
+    if (frame + 1 < frames && interrupt_signal() != 0) {
+      if (params.on_pass) params.on_pass(result, sampler, true);
+      return;
+    }
   }
 }
 

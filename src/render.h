@@ -66,6 +66,7 @@ struct pass_record {
 // The outcome of a render.
 struct render_result {
   int width = 0, height = 0;
+  int frame = 0;              // the animation frame (render_frames; a checkpoint of frame k resumes there)
   std::vector<double> film;   // per pixel RGB sums over all completed samples, each pass's times its weight
   double film_weight = 0;     // the sum of the weights of one pixel's samples (= spp when all weigh 1)
   int spp = 0;                // samples per pixel in the film
@@ -105,7 +106,9 @@ render_result render(const scene_data& scene, const bvh_data& bvh, const light_d
 // frame, its statistics scaled by params.frame_decay at each frame start. Frame k draws the streams of
 // frame_seed(seed, k) with the same pass schedule, so frame k of a non-learning sampler equals a single render
 // with that frame's sun and that seed (a learning sampler must not draw again the samples it learned from). Calls
-// on_frame(k, result) after each frame; stops after an interrupted frame (its result says so).
+// on_frame(k, result) after each frame; stops after an interrupted frame (its result says so). A restored state
+// (params.restore, a checkpoint) of frame k starts there: frames before k are not rendered again. A signal that
+// comes while on_frame runs ends the animation after that frame (on_pass is then called once more, last = true).
 void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lights, const render_params& params,
                    const std::function<void(int, const render_result&)>& on_frame);
 // The film's weighted mean image, negative values written as zero (zero when no sample completed).

@@ -300,3 +300,52 @@ TEST_CASE("an animation says a frame's unwritable output when it happens, and go
   CHECK(std::filesystem::file_size(a.dir / "f_0.pfm") > 24 * 18 * 12);
   CHECK(std::filesystem::file_size(a.dir / "f_2.pfm") > 24 * 18 * 12);
 }
+
+TEST_CASE("an animation killed, interrupted or stopped between frames resumes to the same frames", "[animation][checkpoint]") {
+  // A checkpoint holds the frame under way; --resume continues there (its learned state carries the earlier frames'
+  // statistics), so every frame equals the uninterrupted animation's, bit for bit.
+  anim_scene a;
+  std::string anim = a.scene("anim.json", sun_start, &sun_end);
+  const std::string ck = a.dir / "ck.bin";
+  auto frame = [&](const std::string& stem, int k) { return a.dir / (stem + "_" + std::to_string(k) + ".pfm"); };
+  for (const char* s : {"bayes", "donikian", "bound"}) {
+    INFO(s);
+    // 27 spp: 14 passes a frame, so pass 17 is frame 1's third.
+    const std::string args = "render " + anim + " --sampler " + s + " --frames 3 --spp 27 --quiet";
+    REQUIRE(run_bayeslight(args + " -o " + (a.dir / "full_%d.pfm")).status == 0);
+    struct stop {
+      const char* how;
+      int status;
+      int frames_left;  // frames written by the stopped run
+    };
+    for (const stop& st : {stop{"--checkpoint-every 1000 --kill-after-passes 17", 128 + 9, 1},
+                           stop{"--stop-after-passes 17", 130, 2}, stop{"--signal-after-last-pass", 130, 1}}) {
+      INFO(st.how);
+      for (int k = 0; k < 3; k++) std::filesystem::remove(frame("part", k));
+      std::filesystem::remove(ck);
+      auto r1 = run_bayeslight(args + " -o " + (a.dir / "part_%d.pfm") + " --checkpoint " + ck + " " + st.how);
+      INFO(r1.output);
+      CHECK(r1.status == st.status);
+      for (int k = 0; k < 3; k++) CHECK(std::filesystem::exists(frame("part", k)) == (k < st.frames_left));
+      if (std::string(st.how) == "--signal-after-last-pass")
+        CHECK(r1.output.find("after frame 0; frames 1 to 2 were not rendered; --resume " + ck) != std::string::npos);
+      auto r2 = run_bayeslight(args + " -o " + (a.dir / "part_%d.pfm") + " --resume " + ck);
+      INFO(r2.output);
+      REQUIRE(r2.status == 0);
+      for (int k = 0; k < 3; k++) CHECK(read_file(frame("part", k)) == read_file(frame("full", k)));
+    }
+  }
+  // Resumed with another frame count or decay (other suns, other statistics): refused. A frame's file lost after the
+  // checkpoint is named (it cannot be rendered alone).
+  const std::string base = "render " + anim + " --spp 27 --quiet -o " + (a.dir / "part_%d.pfm");
+  const std::string args = base + " --frames 3";
+  REQUIRE(run_bayeslight(args + " --checkpoint " + ck + " --stop-after-passes 17").status == 130);
+  CHECK(run_bayeslight(base + " --frames 4 --resume " + ck).status == 3);
+  CHECK(run_bayeslight(args + " --frame-decay 0.7 --resume " + ck).status == 3);
+  CHECK(run_bayeslight("render " + anim + " --spp 27 --quiet -o " + (a.dir / "still.pfm") + " --resume " + ck).status == 3);
+  std::filesystem::remove(frame("part", 0));
+  auto r = run_bayeslight(args + " --resume " + ck);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("resuming the animation at frame 1 of 3") != std::string::npos);
+  CHECK(r.output.find("part_0.pfm is missing") != std::string::npos);
+}
