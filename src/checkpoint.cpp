@@ -25,6 +25,12 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // and an RGB mask's luminance, cells of at least 4 ulps
 constexpr uint32_t version = 15;
 
+}  // namespace
+
+uint32_t checkpoint_format_version() { return version; }
+
+namespace {
+
 // Running 64-bit hash of bytes (8 at a time through mix64).
 struct hasher {
   uint64_t h = 0x243f6a8885a308d3ull;

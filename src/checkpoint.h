@@ -20,6 +20,9 @@ namespace bl {
 // and its parameters). The spp target and time budget are not part of it: a render may be resumed further.
 uint64_t render_fingerprint(const scene_data& scene, const render_params& params);
 
+// The version of the checkpoint layout: a checkpoint of another one is refused (bayeslight --version says it).
+uint32_t checkpoint_format_version();
+
 // The checksum a checkpoint ends with, of everything before it (a guard against accidental damage, not a seal).
 uint64_t checkpoint_checksum(std::string_view body);
 

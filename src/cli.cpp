@@ -18,6 +18,8 @@
 #include "scene_desc.h"
 
 #include <CLI/CLI.hpp>
+#include <embree3/rtcore_config.h>
+#include <oneapi/tbb/version.h>
 
 #include <unistd.h>
 
@@ -911,6 +913,30 @@ static int help_exit(CLI::App& app, const CLI::Error& e) {
   return status;
 }
 
+// bayeslight --version: what a bug report needs (the checkpoint format says which checkpoints this binary resumes).
+void print_version() {
+#ifndef BAYESLIGHT_VERSION
+#define BAYESLIGHT_VERSION "unknown"
+#define BAYESLIGHT_BUILD_TYPE "unknown"
+#endif
+#if defined(__clang__)
+  const std::string compiler = "clang " __clang_version__;
+#elif defined(__GNUC__)
+  const std::string compiler = "GCC " __VERSION__;
+#else
+  const std::string compiler = "an unknown compiler";
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+  const char* sanitizers = ", ASan + UBSan";
+#else
+  const char* sanitizers = "";
+#endif
+  std::printf("bayeslight %s\ncheckpoint format %u\nbuilt with %s (%s%s; -ffp-contract=off, no fast-math, no host-specific "
+              "instructions), Embree %s, oneTBB %s\n",
+              BAYESLIGHT_VERSION, unsigned(checkpoint_format_version()), compiler.c_str(), BAYESLIGHT_BUILD_TYPE,
+              sanitizers, RTC_VERSION_STRING, TBB_VERSION_STRING);
+}
+
 int run_cli(int argc, char** argv) {
   // A reader that goes away (a pipe into head, a FIFO output's reader) makes writes fail with EPIPE, reported as
   // write failures (stdout, outputs), instead of killing the process between outputs; stderr's messages are lost.
@@ -923,7 +949,7 @@ int run_cli(int argc, char** argv) {
       "  bayeslight render scene.json --time 10 --reference ref.exr --log log.csv -o out.png\n"
       "  bayeslight compare scene.json --reference ref.exr --time 10 --samplers bound,bayes --out cmp\n"
       "  bayeslight diff out.exr ref.exr\n"
-      "Each command's options: bayeslight COMMAND --help.\n"
+      "Each command's options: bayeslight COMMAND --help. The version and build: bayeslight --version.\n"
       "Exit status: 0 success; 1 other failure (e.g. an output that cannot be written); 2 bad command line; 3 bad "
       "input (the message names the file and line); 130/143/129 interrupted (SIGINT/SIGTERM/SIGHUP), after writing the "
       "image of the passes completed.");
@@ -938,6 +964,10 @@ int run_cli(int argc, char** argv) {
   diff->add_option("A", dopt.a, "Image (.exr/.pfm)")->required();
   diff->add_option("B", dopt.b, "Image (.exr/.pfm), the reference")->required();
   std::string first = argc >= 2 ? argv[1] : "";
+  if (argc == 2 && (first == "--version" || first == "-V")) {
+    print_version();
+    return exit_ok;
+  }
   if (!first.empty() && first[0] != '-' && first != "render" && first != "diff" && first != "compare" &&
       first != "profile") {
     std::fprintf(stderr, "bayeslight: error: unknown command \"%s\" (commands: render, compare, profile, diff)\n"

@@ -1,5 +1,6 @@
 // Tests of the command line as users drive it: exit statuses (SPEC.md section 4), messages that name the
 // problem (file and line), no output file left behind by a failure, the diff command, and the per-pass log.
+#include "checkpoint.h"
 #include "image_io.h"
 #include "render.h"
 #include "scene_desc.h"
@@ -83,6 +84,17 @@ TEST_CASE("lights too small for float precision where they are are warned about"
   CHECK(r.status == 0);
   CHECK(r.output.find("warning: the lights are so far from the origin for their size that rays leave surfaces by") !=
         std::string::npos);
+}
+
+TEST_CASE("--version names the version, the checkpoint format and the build", "[cli]") {
+  auto r = run_bayeslight("--version");
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.rfind("bayeslight 0.", 0) == 0);
+  CHECK(r.output.find("checkpoint format " + std::to_string(checkpoint_format_version()) + "\n") != std::string::npos);
+  CHECK(r.output.find("Embree 3.") != std::string::npos);
+  CHECK(r.output.find("-ffp-contract=off") != std::string::npos);
+  CHECK(run_bayeslight("--version render").status == 2);  // (a flag of its own, not an option of a command)
 }
 
 TEST_CASE("a render writes every requested output and a per pass log", "[cli]") {
