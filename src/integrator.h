@@ -65,7 +65,11 @@ struct null_sink {
 // The shadow ray of light sample ls at sp: between both points, each moved off its own surface by min_ray_epsilon
 // (so neither the receiver nor the emitter itself can block it, even at grazing angles, while a lamp just above a
 // floor stays lit and a thin occluder beside the point still casts its shadow); toward the sun, unbounded. tmax = 0
-// when both ends coincide (nothing can block the sample).
+// when both ends coincide (nothing can block the sample). The emitter's end also stays off the emitter by a millionth
+// of the ray's length: the ray's direction and length are rounded to float, and Embree's hit distance too, by a few
+// ulps of that length, so a lamp whose own coordinates are small (near the origin) lying far from the point was hit by
+// its own shadow ray (a review: a 10 cm lamp at y = 0 lit a floor 2 below it to 9 % of the right value, 86 % of its
+// samples blocked).
 struct shadow_ray {
   vec3f org, dir;
   float tmax = 0;
@@ -73,7 +77,7 @@ struct shadow_ray {
 inline shadow_ray shadow_ray_of(const scene_data& scene, const surface_point& sp, const light_sample& ls) {
   vec3f o = offset_along(sp.p, sp.ng, ls.wi, min_ray_epsilon(scene, sp.tri, sp.p));
   if (ls.dist == inf_f) return {o, ls.wi, inf_f};
-  vec3f target = offset_along(ls.p, ls.n, -ls.wi, min_ray_epsilon(scene, ls.tri, ls.p));
+  vec3f target = offset_along(ls.p, ls.n, -ls.wi, std::max(min_ray_epsilon(scene, ls.tri, ls.p), 1e-6f * ls.dist));
   vec3f d = target - o;
   float t = length(d);
   if (!(t > 0)) return {o, ls.wi, 0.0f};
