@@ -2,6 +2,7 @@
 // non-learning sampler equals, bit for bit, a single render of a scene file stating that frame's sun; a
 // learning sampler's frame 0 does too, its later frames (which start from the decayed statistics of the earlier
 // ones) agree statistically with a single render, and animations are deterministic across thread counts.
+#include "checkpoint.h"
 #include "file_io.h"
 #include "image_io.h"
 #include "metrics.h"
@@ -12,6 +13,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <unistd.h>
 
@@ -343,6 +345,19 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
   CHECK(run_bayeslight(base + " --frames 4 --resume " + ck).status == 3);
   CHECK(run_bayeslight(args + " --frame-decay 0.7 --resume " + ck).status == 3);
   CHECK(run_bayeslight("render " + anim + " --spp 27 --quiet -o " + (a.dir / "still.pfm") + " --resume " + ck).status == 3);
+  // The frame index (after magic, version, fingerprint, reference hash, sampler kind, width and height) edited out of
+  // range and the file re-sealed with its checksum: refused, never followed.
+  const std::string saved = read_file(ck);
+  for (int bad : {-1, 3, 1 << 30}) {
+    std::string body = saved.substr(0, saved.size() - 8);
+    std::memcpy(&body[16 + 4 + 8 + 8 + 4 + 4 + 4], &bad, sizeof bad);
+    uint64_t h = checkpoint_checksum(body);
+    write_text(a.dir / "edited.bin", body + std::string(reinterpret_cast<const char*>(&h), 8));
+    auto e = run_bayeslight(args + " --resume " + (a.dir / "edited.bin"));
+    INFO(bad << ": " << e.output);
+    CHECK(e.status == 3);
+    CHECK(e.output.find("edited.bin: corrupt checkpoint: frame") != std::string::npos);
+  }
   std::filesystem::remove(frame("part", 0));
   auto r = run_bayeslight(args + " --resume " + ck);
   CHECK(r.status == 0);
