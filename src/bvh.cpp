@@ -4,6 +4,7 @@
 #include "errors.h"
 #include "texture.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -147,6 +148,58 @@ hit_info intersect_triangle(const scene_data& s, int tri, vec3f org, vec3f dir) 
     h.p = interpolated_point(s, tri, b1, b2);
   }
   return h;
+}
+
+namespace {
+
+struct on_surface_query {
+  const scene_data* scene;
+  const std::vector<int>* light_of_tri;
+  int emitter;
+  vec3f c;     // the emitter's centroid
+  float tol;   // how far from a plane c still lies on it
+  int found = invalid_id;
+};
+
+// rtcPointQuery's callback, for each triangle whose bounds reach the query sphere.
+bool on_surface_candidate(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<on_surface_query*>(args->userPtr);
+  const int t = int(args->primID);
+  const scene_data& s = *q->scene;
+  if (q->found != invalid_id || t == q->emitter || (*q->light_of_tri)[size_t(t)] != invalid_id) return false;
+  const vec3f n = s.tri_ng[size_t(t)], v = q->c - s.tri_p0[size_t(t)];
+  if (std::fabs(dot(n, s.tri_ng[size_t(q->emitter)])) < 0.9999f || std::fabs(dot(n, v)) > q->tol) return false;
+  // c's barycentrics in t's plane.
+  const vec3f e1 = s.tri_e1[size_t(t)], e2 = s.tri_e2[size_t(t)];
+  const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), v1 = dot(v, e1), v2 = dot(v, e2);
+  const float den = d11 * d22 - d12 * d12;
+  if (!(den > 0)) return false;
+  const float b1 = (d22 * v1 - d12 * v2) / den, b2 = (d11 * v2 - d12 * v1) / den;
+  if (!(b1 >= 0 && b2 >= 0 && b1 + b2 <= 1) || alpha_hole(s, t, b1, b2)) return false;
+  q->found = t;
+  return false;  // (the query's radius is unchanged)
+}
+
+}  // namespace
+
+emitter_on_surface find_emitters_on_surfaces(const bvh_data& bvh, const scene_data& scene,
+                                             const std::vector<int>& emitters, const std::vector<int>& light_of_tri) {
+  emitter_on_surface r;
+  for (int e : emitters) {
+    on_surface_query q{&scene, &light_of_tri, e, {}, 0};
+    q.c = scene.tri_p0[size_t(e)] + (scene.tri_e1[size_t(e)] + scene.tri_e2[size_t(e)]) * (1.0f / 3);
+    q.tol = min_ray_epsilon(scene, e, q.c);
+    RTCPointQuery pq;
+    pq.x = q.c.x, pq.y = q.c.y, pq.z = q.c.z;
+    pq.time = 0;
+    pq.radius = q.tol;
+    RTCPointQueryContext ctx;
+    rtcInitPointQueryContext(&ctx);
+    rtcPointQuery(bvh.scene, &pq, &ctx, on_surface_candidate, &q);
+    if (q.found == invalid_id) continue;
+    if (r.count++ == 0) r.emitter = e, r.surface = q.found;
+  }
+  return r;
 }
 
 hit_info intersect(const bvh_data& b, vec3f org, vec3f dir, float tmax, float tnear) {

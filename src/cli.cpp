@@ -406,6 +406,25 @@ int run_render(const render_options& o) {
                    "scene nearer the origin\n",
                    o.scene.c_str(), double(ratio[ratio.size() / 2]));
   }
+  if (lights.tri_count > 0) {
+    emitter_on_surface on = find_emitters_on_surfaces(bvh, scene, lights.tri, lights.light_of_tri);
+    if (on.count > 0) {
+      const std::vector<material_data>& mats = scene.mesh.materials;
+      auto name = [&](int t) {
+        int m = scene.mesh.tri_materials[size_t(t)];
+        return m >= 0 && size_t(m) < mats.size() && !mats[size_t(m)].name.empty() ? "\"" + mats[size_t(m)].name + "\""
+                                                                              : std::string("the default material");
+      };
+      vec3f c = scene.tri_p0[size_t(on.emitter)] +
+                (scene.tri_e1[size_t(on.emitter)] + scene.tri_e2[size_t(on.emitter)]) * (1.0f / 3);
+      std::fprintf(stderr,
+                   "%s: warning: %d emitting triangle%s on another surface (%s at (%.6g, %.6g, %.6g) on a triangle "
+                   "of %s): rays meet either of two coincident faces, so the light near that surface differs between "
+                   "samplers and depths; move the emitter off the surface (by 1e-4 of the scene's size)\n",
+                   o.scene.c_str(), on.count, on.count == 1 ? " lies" : "s lie", name(on.emitter).c_str(), double(c.x),
+                   double(c.y), double(c.z), name(on.surface).c_str());
+    }
+  }
   if (!o.quiet) {
     auto t_end = std::chrono::steady_clock::now();
     std::fprintf(stderr, "%s: %zu triangles, %d lights%s; loaded in %.2f s, Embree BVH and lights in %.2f s\n",
