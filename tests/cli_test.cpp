@@ -111,7 +111,7 @@ TEST_CASE("an emitter lying on another surface is warned about, one just off it 
   CHECK(off.output.find("another surface") == std::string::npos);
 }
 
-TEST_CASE("--version names the version, the checkpoint format and the build", "[cli]") {
+TEST_CASE("bayeslight --version names the version, the checkpoint format and the build", "[cli]") {
   auto r = run_bayeslight("--version");
   INFO(r.output);
   CHECK(r.status == 0);
