@@ -60,6 +60,11 @@ bvh_data build_bvh(const scene_data& s) {
   rtcSetDeviceErrorFunction(b.device, embree_error, &error);
   b.scene = rtcNewScene(b.device);
   rtcSetSceneBuildQuality(b.scene, RTC_BUILD_QUALITY_MEDIUM);
+  // Robust (watertight) triangle tests: by default rays fell through the shared edge of two triangles where the
+  // edge's float test rounds both ways (a review: a ground quad of side 2e6 lost 81 camera pixels along its diagonal,
+  // 2e7 486 of 7168, and shadow rays leak the same way). No measurable cost here (medians of 3 alternating renders:
+  // living room direct uniform 1.91 / 1.96 s, hall path bound 2.93 / 2.87, plant room path bayes 1.94 / 1.75 s).
+  rtcSetSceneFlags(b.scene, RTC_SCENE_FLAG_ROBUST);
   const mesh_data& m = s.mesh;
   int n = triangle_count(m);
   if (n > 0) {
