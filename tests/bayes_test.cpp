@@ -294,6 +294,49 @@ TEST_CASE("the reference posterior weight is the conjugate Normal inverse gamma 
     }
 }
 
+TEST_CASE("a pair's control-variate posterior is the Normal inverse gamma update of its samples", "[bayes]") {
+  // pair_posterior's k (posterior mean of z) and h (posterior expected variance, beta_n / (alpha_n - 1)) feed the
+  // control variates; the test of those takes them from pair_posterior itself, so they are checked here against the
+  // conjugate update computed from the raw samples (a mutation alpha_n = alpha0 + n1 went unnoticed but for goldens).
+  bayes_params p;
+  p.kappa0 = 1, p.alpha0 = 2, p.c = 0.3;
+  bayes_stats s;
+  resize_stats(s, 1, p);
+  s.m[0] = {0, 4, 2, 3};  // four non-zero samples of mean 2 and squared deviations summing to 3
+  double k = 0, h = 0;
+  REQUIRE(pair_posterior(s, 0, p, 1.0, k, h));
+  // kappa_n = 5, k = (1 + 8) / 5; alpha_n = 2 + 2; beta_n = 0.3 (2 - 1) + (3 + 4 (2 - 1)^2 / 5) / 2 = 2.2.
+  CHECK(k == Approx(1.8).epsilon(1e-12));
+  CHECK(h == Approx(2.2 / 3).epsilon(1e-12));
+  bayes_params naive = p;
+  naive.prior = false;
+  REQUIRE(pair_posterior(s, 0, naive, 1.0, k, h));
+  CHECK(k == 2);
+  CHECK(h == Approx(0.75).epsilon(1e-12));
+  // Random samples, other priors: from the samples themselves, in long double.
+  pcg32 rng(41, 3);
+  for (int trial = 0; trial < 50; trial++) {
+    bayes_params q;
+    q.kappa0 = 0.1 + 4 * unif64(rng), q.alpha0 = 1.5 + 3 * unif64(rng);
+    q.c = 0.05 + unif64(rng);
+    const int n = 1 + int(40 * unif64(rng));
+    const double mu0 = 0.01 + 10 * unif64(rng);
+    std::vector<double> z;
+    for (int i = 0; i < n; i++) z.push_back(mu0 * (0.2 + 3 * unif64(rng)));
+    moments m = exact_moments(z);
+    s.m[0] = {0, m.n1, m.mean, m.m2};
+    REQUIRE(pair_posterior(s, 0, q, mu0, k, h));
+    long double sum = 0, kn = q.kappa0 + n;
+    for (double v : z) sum += v;
+    long double mean = sum / n, ss = 0;
+    for (double v : z) ss += (v - mean) * (v - mean);
+    long double beta = q.c * mu0 * mu0 * (q.alpha0 - 1) + ss / 2 + q.kappa0 * n * (mean - mu0) * (mean - mu0) / (2 * kn);
+    INFO("trial " << trial << " n " << n);
+    CHECK(rel_err(k, double((q.kappa0 * mu0 + sum) / kn)) < 1e-12);
+    CHECK(rel_err(h, double(beta / (q.alpha0 + n / 2.0L - 1))) < 1e-12);
+  }
+}
+
 TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes]") {
   // Random statistics over many orders of magnitude, merged through rows; eval_weight (float coefficients)
   // must agree with posterior_weight (double) to 1e-5 relative for random v = scale * bound and g = 1 / d^2.
