@@ -19,6 +19,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <optional>
+
 #include <algorithm>
 #include <array>
 #include <cfloat>
@@ -759,6 +761,50 @@ TEST_CASE("under a cut shared by every region the bound sampler keeps the root a
     if (ctx->count != via_cell->count || !std::equal(ctx->nodes, ctx->nodes + ctx->count, via_cell->nodes)) differ++;
   }
   CHECK(differ == 0);
+}
+
+TEST_CASE("a point whose fine cell has no region uses its coarse cell's region, else the root", "[samplers][regions]") {
+  // The fallback only costs variance when wrong (a mutation sending such points to the root passed every test but the
+  // goldens): checked on the region a point locates.
+  auto t = make_test_scene(true);
+  sampler_params sp;
+  sp.kind = sampler_kind::bound;
+  sp.regions.shared_cut_lights = 0;
+  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+  region_state s = std::get<bound_sampler>(ls).regions;
+  REQUIRE_FALSE(s.shared_cut);
+  const std::vector<shade_point> pts = shading_points(*t, 400, 5);
+  const shade_point& p = pts[0];
+  const uint64_t k = fine_region_key(s.grid, p.p), coarse = parent_region_key(s.grid, k, 1);
+  REQUIRE(add_regions(s, t->tree, {k}) == 2);  // its coarse parent, then itself
+  // A point one fine cell away inside the same coarse cell, and a point of another coarse cell.
+  std::optional<shade_point> same_coarse, other_coarse;
+  const float c = s.grid.cell[0];
+  for (vec3f step : {vec3f{c, 0, 0}, vec3f{-c, 0, 0}, vec3f{0, 0, c}, vec3f{0, 0, -c}, vec3f{0, c, 0}, vec3f{0, -c, 0}}) {
+    shade_point q = p;
+    q.p = p.p + step;
+    uint64_t qk = fine_region_key(s.grid, q.p);
+    if (qk != k && parent_region_key(s.grid, qk, 1) == coarse && !same_coarse) same_coarse = q;
+  }
+  for (const shade_point& q : pts)
+    if (parent_region_key(s.grid, fine_region_key(s.grid, q.p), 1) != coarse && !other_coarse) other_coarse = q;
+  REQUIRE(same_coarse);
+  REQUIRE(other_coarse);
+  const uint64_t root = s.key[size_t(s.root)];
+  REQUIRE(coarse != root);
+  auto at = [&](shade_point q, int depth) {
+    auto ctx = std::make_unique<cut_context>();
+    q.depth = depth;
+    locate_region(*ctx, s, q, false);
+    return ctx->region_key;
+  };
+  for (int depth : {1, s.params.fine_depth + 1}) {
+    INFO("depth " << depth);
+    const bool fine = depth <= s.params.fine_depth;
+    CHECK(at(p, depth) == (fine ? k : coarse));
+    CHECK(at(*same_coarse, depth) == coarse);
+    CHECK(at(*other_coarse, depth) == root);
+  }
 }
 
 TEST_CASE("a scene without any light gives empty light selections", "[samplers]") {
