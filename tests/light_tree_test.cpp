@@ -3,6 +3,7 @@
 // of sampled leaves against intensity_descent_pmf at significance 1e-3, returned probabilities bitwise equal
 // to the pmf, every leaf of positive intensity reachable with probability > 0), conservativeness of node_importance and node_region_bound (a zero never hides a light that can
 // reach the point), and the partition property of compute_light_cut.
+#include "cluster_bounds.h"
 #include "light_tree.h"
 #include "lights.h"
 #include "region_grid.h"
@@ -480,6 +481,41 @@ TEST_CASE("node importance is zero only for nodes that cannot light the point", 
     }
     INFO("set " << sc.name << ": " << zeros << " zero-importance (node, point) pairs checked");
     CHECK(violations == 0);
+  }
+}
+
+TEST_CASE("the four-wide node bounds are the scalar node importance, bit for bit", "[light_tree]") {
+  // eval_node_bounds (SSE, what bound and bayes weigh clusters by) promises node_importance_parts's bits; the bound
+  // and bayes samplers share it, so comparing them could not see a factor it dropped (a mutation review: the
+  // receiver's cosine bound left out was caught by two ablation tests only).
+  for (const set_case& sc : set_cases) {
+    light_set s = make_light_set(sc.seed, sc.n, sc.kind, sc.two_sided);
+    const light_tree_data& t = s.tree;
+    if (node_count(t) == 0) continue;
+    pcg32 rng(sc.seed, 17);
+    bbox3f bounds = s.scene.bounds;
+    vec3f grow = extent(bounds) * 0.5f + vec3f{1, 1, 1};
+    std::vector<int> nodes(size_t(node_count(t)));
+    for (int k = 0; k < node_count(t); k++) nodes[size_t(k)] = k;
+    std::vector<float> num(nodes.size() + 4), inv(nodes.size() + 4);
+    int mismatches = 0;
+    for (int k = 0; k < 100; k++) {
+      vec3f p = random_in(rng, bounds.lo - grow, bounds.hi + grow), n = random_unit(rng);
+      // Every node, in runs of each length mod 4 (the SSE loop's tail).
+      int count = node_count(t) - int(rng(4u)) % std::max(1, node_count(t));
+      eval_node_bounds(t, nodes.data(), count, p, n, num.data(), inv.data());
+      for (int j = 0; j < count; j++) {
+        float ref_inv;
+        float ref = node_importance_parts(t, nodes[size_t(j)], p, n, ref_inv);
+        if (std::memcmp(&ref, &num[size_t(j)], 4) != 0 || std::memcmp(&ref_inv, &inv[size_t(j)], 4) != 0) {
+          if (mismatches++ == 0)
+            UNSCOPED_INFO("set " << sc.name << " node " << j << ": " << num[size_t(j)] << " / " << inv[size_t(j)]
+                                 << " against " << ref << " / " << ref_inv);
+        }
+      }
+    }
+    INFO("set " << sc.name);
+    CHECK(mismatches == 0);
   }
 }
 
