@@ -16,7 +16,10 @@ key=$(ref_key "$(dirname "$scene")" "$glob" "$(basename "$scene") $W $H $REF_SPP
 ref="$dir/$(basename "$(dirname "$scene")")_$(basename "$scene" .json)_$key.exr"
 if [ ! -f "$ref" ]; then
   echo "reference: $REF_SAMPLER $REF_SPP spp -> $ref" >&2
-  "$bin" render "$scene" --sampler "$REF_SAMPLER" --spp "$REF_SPP" --seed 987654321 --width "$W" --height "$H" $extra -o "$ref" --quiet
+  # (under a temporary name until complete: an interrupted render writes its partial image)
+  "$bin" render "$scene" --sampler "$REF_SAMPLER" --spp "$REF_SPP" --seed 987654321 --width "$W" --height "$H" $extra \
+    -o "$ref.part.exr" --quiet
+  mv "$ref.part.exr" "$ref"
 fi
 tmp=$(mktemp -d)
 for s in $samplers; do
