@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <climits>
 #include <csignal>
@@ -52,6 +53,12 @@ void signal_safe_line(const char* line) {
 }
 
 extern "C" void on_interrupt(int sig) {
+  // The handler's write(2) fails with stderr closed or full, and would leave its errno to the interrupted thread, which
+  // may be between a failed call of its own and reading errno (a TSan review: "signal handler spoils errno").
+  struct keep_errno {
+    int saved = errno;
+    ~keep_errno() { errno = saved; }
+  } keep;
   const int which = sig == SIGTERM ? 1 : sig == SIGHUP ? 2 : 0;
   int phase = g_phase.load();
   if (phase == phase_setup || phase == phase_render_setup) {
