@@ -4,6 +4,8 @@
 #include "errors.h"
 #include "texture.h"
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -189,8 +191,11 @@ bool on_surface_candidate(RTCPointQueryFunctionArguments* args) {
 
 emitter_on_surface find_emitters_on_surfaces(const bvh_data& bvh, const scene_data& scene,
                                              const std::vector<int>& emitters, const std::vector<int>& light_of_tri) {
-  emitter_on_surface r;
-  for (int e : emitters) {
+  // One query per emitter, in parallel (an emitter inside a fan of 16000 triangles meets them all: 100000 such lamps
+  // took 10.7 s on 2 threads); the first in emitter order is the one named.
+  std::vector<int> found(emitters.size(), invalid_id);
+  tbb::parallel_for(size_t(0), emitters.size(), [&](size_t i) {
+    const int e = emitters[i];
     on_surface_query q{&scene, &light_of_tri, e, {}, 0};
     q.c = scene.tri_p0[size_t(e)] + (scene.tri_e1[size_t(e)] + scene.tri_e2[size_t(e)]) * (1.0f / 3);
     q.tol = min_ray_epsilon(scene, e, q.c);
@@ -201,9 +206,11 @@ emitter_on_surface find_emitters_on_surfaces(const bvh_data& bvh, const scene_da
     RTCPointQueryContext ctx;
     rtcInitPointQueryContext(&ctx);
     rtcPointQuery(bvh.scene, &pq, &ctx, on_surface_candidate, &q);
-    if (q.found == invalid_id) continue;
-    if (r.count++ == 0) r.emitter = e, r.surface = q.found;
-  }
+    found[i] = q.found;
+  });
+  emitter_on_surface r;
+  for (size_t i = 0; i < emitters.size(); i++)
+    if (found[i] != invalid_id && r.count++ == 0) r.emitter = emitters[i], r.surface = found[i];
   return r;
 }
 

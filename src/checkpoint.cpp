@@ -349,6 +349,10 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
     // its statistics a frame keeps. (A still's fingerprint is what it was before animations could be resumed.)
     h.value(p.frames), h.value(scene.sun.animated), h.vec(scene.sun.direction_end);
     if (k == sampler_kind::bayes || k == sampler_kind::donikian) h.value(p.frame_decay);
+    // And its samples per frame: the frames before the checkpoint's were rendered with them, and a learning sampler's
+    // later frames start from what those learned (a resume with another --spp was taken silently; a review).
+    h.value(p.time_budget);
+    if (!(p.time_budget > 0)) h.value(p.spp);
   }
   // Only the options of the sampler in use: a uniform render resumed with another --grid or --bayes-b0 (which
   // cannot change its image) was refused as a different render.
@@ -504,7 +508,8 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
   reader r{body, path, sizeof magic};
   if (r.value<uint32_t>() != version) throw input_error(path, "checkpoint of another bayeslight version");
   if (r.value<uint64_t>() != fingerprint)
-    throw input_error(path, "checkpoint was written for a different scene or different render options");
+    throw input_error(path, std::string("checkpoint was written for a different scene or different render options") +
+                                (params.frames > 1 ? " (an animation's also for another --frames, --spp or --time)" : ""));
   const uint64_t reference = r.value<uint64_t>();
   if (r.value<uint32_t>() != uint32_t(sampler.index())) r.fail("sampler kind");
   int w = r.value<int>(), hgt = r.value<int>();
@@ -556,9 +561,10 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
   }
   if (result.film_weight != weight) r.fail("film weight");
   // Every sample is a finite float, so every pixel's mean converts to a finite float as the image does it (film_image);
-  // a value finite in double but beyond that (an edit) was written as an infinite pixel.
+  // a value finite in double but beyond that (an edit) was written as an infinite pixel. Without a pass (an
+  // animation's frame stopped before its first) the film is empty: all zeros.
   for (double x : result.film)
-    if (!std::isfinite(float(x / weight))) r.fail("film");
+    if (weight > 0 ? !std::isfinite(float(x / weight)) : x != 0) r.fail("film");
   if (auto* b = std::get_if<bayes_sampler>(&sampler); b && !b->px_var.empty() && b->px_var.size() != result.film.size() / 3)
     r.fail("fallback check");  // its columns are indexed by pixel
   if (r.pos != body.size()) r.fail("trailing data");

@@ -77,6 +77,7 @@ struct render_options {
   bool signal_after_last_pass = false;  // testing aid: raise SIGINT once the last pass is done, before the outputs
   int kill_after_passes = 0;  // testing aid: raise SIGKILL right after the checkpoint of this pass
   int signals_in_first_pass = 0;  // testing aid: raise SIGINT this many times once the first pass's first row is done
+  int signal_frame = -1;          // testing aid: raise SIGINT once during this frame's first pass (frames > 0)
   std::vector<std::pair<std::string, std::string>> given;  // options given on the command line: (name, help group)
 };
 
@@ -357,6 +358,7 @@ int run_render(const render_options& o) {
   render_params params = resolve_params(o, desc, kind);
   params.finish_first_pass = true;  // (an interrupted render has an image to write)
   params.signals_in_first_pass = o.signals_in_first_pass;
+  params.signal_frame = o.signal_frame;
   warn_after_scene(o, params, {kind});
   if (o.frames > 1 && !(desc.sun.enabled && desc.sun.animated))
     std::fprintf(stderr, "%s: warning: %s, so the %d frames show the same scene (the sun moves to sun.direction_end)\n",
@@ -509,9 +511,10 @@ int run_render(const render_options& o) {
     const int passes = earlier_passes + r.passes;
     if (!last && o.stop_after_passes > 0 && passes == o.stop_after_passes) std::raise(SIGINT);
     if (last && o.signal_after_last_pass) std::raise(SIGINT);
-    // A render stopped before its first pass has nothing to save: a checkpoint already there is kept (an
-    // animation's frame k stopped so: the checkpoint of frame k - 1's end, from which it resumes).
-    if (o.checkpoint.empty() || r.passes == 0) return;
+    // A render stopped before its first pass has nothing to save: a checkpoint already there is kept. An animation's
+    // later frame stopped so has: the statistics the earlier frames left it (decayed), from which it resumes (the end
+    // of the frame before was saved only when due; a review: nothing to resume from after a signal in frame 1).
+    if (o.checkpoint.empty() || (r.passes == 0 && !(last && r.frame > 0))) return;
     auto now = std::chrono::steady_clock::now();
     bool due = std::chrono::duration<double>(now - last_write).count() >= o.checkpoint_every;
     // The end of the render is always saved; an animation's other frame ends only when due (100 short frames
@@ -567,9 +570,17 @@ int run_render(const render_options& o) {
   // A signal that came after the last pass (while the outputs were written) still ends the run as interrupted.
   if (interrupted || interrupt_signal() != 0) {
     int sig = interrupt_signal();
-    if (!interrupted && last_frame + 1 < params.frames)  // (between an animation's frames)
-      std::fprintf(stderr, "bayeslight: interrupted (%s) after frame %d; frames %d to %d were not rendered%s\n",
-                   signal_name(sig), last_frame, last_frame + 1, params.frames - 1,
+    // The frames after last_frame, as a phrase.
+    const std::string rest = last_frame + 2 == params.frames ? "frame " + std::to_string(last_frame + 1) + " was"
+                             : "frames " + std::to_string(last_frame + 1) + " to " + std::to_string(params.frames - 1) +
+                                   " were";
+    if (interrupted && params.frames > 1)  // (in an animation's frame: say what is left, and how to go on)
+      std::fprintf(stderr, "bayeslight: the animation stopped in frame %d of %d%s%s\n", last_frame, params.frames,
+                   last_frame + 1 < params.frames ? ("; " + rest + " not rendered").c_str() : "",
+                   o.checkpoint.empty() ? "" : ("; --resume " + o.checkpoint + " continues it").c_str());
+    else if (!interrupted && last_frame + 1 < params.frames)  // (between an animation's frames)
+      std::fprintf(stderr, "bayeslight: interrupted (%s) after frame %d; %s not rendered%s\n", signal_name(sig),
+                   last_frame, rest.c_str(),
                    o.checkpoint.empty() ? "" : ("; --resume " + o.checkpoint + " renders them").c_str());
     else if (!interrupted)
       std::fprintf(stderr, "bayeslight: interrupted (%s) after the last pass; every output was written\n",
@@ -822,6 +833,8 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--signals-in-first-pass", o.signals_in_first_pass,
                 "testing: raise SIGINT N times once the first pass's first row is done (-N: 0.6 s apart)")
       ->group("");
+  r->add_option("--signal-in-frame", o.signal_frame, "testing: raise SIGINT once during frame K's first pass (K > 0)")
+      ->group("");
   r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N, counted over frames")
       ->group("");
   r->add_option("--frame-decay", o.frame_decay,
@@ -946,7 +959,17 @@ void print_version() {
   const std::string compiler = "an unknown compiler";
 #endif
 #if defined(__SANITIZE_ADDRESS__)
-  const char* sanitizers = ", ASan + UBSan";
+  const char* sanitizers = ", AddressSanitizer";
+#elif defined(__SANITIZE_THREAD__)
+  const char* sanitizers = ", ThreadSanitizer";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  const char* sanitizers = ", AddressSanitizer";
+#elif __has_feature(thread_sanitizer)
+  const char* sanitizers = ", ThreadSanitizer";
+#else
+  const char* sanitizers = "";
+#endif
 #else
   const char* sanitizers = "";
 #endif
@@ -985,6 +1008,11 @@ int run_cli(int argc, char** argv) {
   std::string first = argc >= 2 ? argv[1] : "";
   if (argc == 2 && (first == "--version" || first == "-V")) {
     print_version();
+    // (stdout full or closed: a failure, as for diff's output)
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+      std::fprintf(stderr, "bayeslight: error: cannot write to standard output\n");
+      return exit_failure;
+    }
     return exit_ok;
   }
   if (!first.empty() && first[0] != '-' && first != "render" && first != "diff" && first != "compare" &&

@@ -281,7 +281,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     render_inputs pin = in;
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
-    const int raise = first ? params.signals_in_first_pass : 0;
+    const int raise = pass == 0 && done == 0 ? params.signals_in_first_pass : 0;
     auto run = [&](const auto& s) {
       return params.profile ? run_pass<true>(pin, s, done, done + count, pass_sum, rows, arena, progress, raise)
                             : run_pass<false>(pin, s, done, done + count, pass_sum, rows, arena, progress, raise);
@@ -476,6 +476,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     result.setup_seconds = frame == first ? setup : 0.0;
     render_params fp = params;
     fp.finish_first_pass = params.finish_first_pass && frame == 0;  // (a later frame stops at once: earlier ones exist)
+    fp.signals_in_first_pass = frame == params.signal_frame && frame > 0 ? 1 : frame == 0 ? params.signals_in_first_pass : 0;
     if (!params.frame_references.empty()) fp.reference = params.frame_references[size_t(frame)];
     if (frame > 0) set_sun_direction(lights, animated_sun_direction(scene.sun, frame, frames));
     if (frame > first) std::visit([&](auto& s) { s.begin_frame(params.frame_decay); }, sampler);

@@ -46,6 +46,7 @@ struct render_params {
   bool finish_first_pass = false;
   // Testing: raise SIGINT this many times once the first pass's first row is done (< 0: -N times, 0.6 s apart).
   int signals_in_first_pass = 0;
+  int signal_frame = -1;  // testing: raise SIGINT once in this frame's first pass (after its first row; frames > 0)
   std::vector<const image_data*> frame_references;  // per frame (overrides `reference` when not empty)
   // Called after every completed pass (last = false) and once when the render ends (last = true), with the state
   // of the completed passes: what a checkpoint saves.

@@ -320,8 +320,11 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
       int status;
       int frames_left;  // frames written by the stopped run
     };
+    // (--signal-in-frame 1: a signal during frame 1's first pass, which stops at once: the checkpoint then holds
+    // frame 1 without a pass, its statistics as frame 0 left them; before, nothing was saved.)
     for (const stop& st : {stop{"--checkpoint-every 1000 --kill-after-passes 17", 128 + 9, 1},
-                           stop{"--stop-after-passes 17", 130, 2}, stop{"--signal-after-last-pass", 130, 1}}) {
+                           stop{"--stop-after-passes 17", 130, 2}, stop{"--signal-after-last-pass", 130, 1},
+                           stop{"--checkpoint-every 1000 --signal-in-frame 1", 130, 1}}) {
       INFO(st.how);
       for (int k = 0; k < 3; k++) std::filesystem::remove(frame("part", k));
       std::filesystem::remove(ck);
@@ -331,6 +334,9 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
       for (int k = 0; k < 3; k++) CHECK(std::filesystem::exists(frame("part", k)) == (k < st.frames_left));
       if (std::string(st.how) == "--signal-after-last-pass")
         CHECK(r1.output.find("after frame 0; frames 1 to 2 were not rendered; --resume " + ck) != std::string::npos);
+      if (std::string(st.how) == "--stop-after-passes 17")
+        CHECK(r1.output.find("the animation stopped in frame 1 of 3; frame 2 was not rendered; --resume " + ck +
+                             " continues it") != std::string::npos);
       auto r2 = run_bayeslight(args + " -o " + (a.dir / "part_%d.pfm") + " --resume " + ck);
       INFO(r2.output);
       REQUIRE(r2.status == 0);
@@ -344,6 +350,11 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
   REQUIRE(run_bayeslight(args + " --checkpoint " + ck + " --stop-after-passes 17").status == 130);
   CHECK(run_bayeslight(base + " --frames 4 --resume " + ck).status == 3);
   CHECK(run_bayeslight(args + " --frame-decay 0.7 --resume " + ck).status == 3);
+  // Nor with other samples per frame: frame 0 was rendered with 27 spp and frame 1 learned from it.
+  auto more = run_bayeslight("render " + anim + " --spp 40 --frames 3 --quiet -o " + (a.dir / "part_%d.pfm") +
+                             " --resume " + ck);
+  CHECK(more.status == 3);
+  CHECK(more.output.find("(an animation's also for another --frames, --spp or --time)") != std::string::npos);
   CHECK(run_bayeslight("render " + anim + " --spp 27 --quiet -o " + (a.dir / "still.pfm") + " --resume " + ck).status == 3);
   // The frame index (after magic, version, fingerprint, reference hash, sampler kind, width and height) edited out of
   // range and the file re-sealed with its checksum: refused, never followed.

@@ -120,6 +120,7 @@ TEST_CASE("bayeslight --version names the version, the checkpoint format and the
   CHECK(r.output.find("Embree 3.") != std::string::npos);
   CHECK(r.output.find("-ffp-contract=off") != std::string::npos);
   CHECK(run_bayeslight("--version render").status == 2);  // (a flag of its own, not an option of a command)
+  CHECK(run_bayeslight("--version >/dev/full").status == 1);  // (stdout that cannot be written: a failure, as diff's)
 }
 
 TEST_CASE("a render writes every requested output and a per pass log", "[cli]") {
