@@ -11,7 +11,7 @@ dir=$(dirname "$bin")/ref; mkdir -p "$dir"
 . "$(dirname "$0")/ref_key.sh"
 # A data/ scene's own goldens; any other scene, every golden (a change of output anywhere renders it again).
 name=$(basename "$(dirname "$scene")"); glob='*'
-[ "$(cd "$(dirname "$scene")/../.." 2>/dev/null && pwd)" = "$ref_key_root" ] && glob="${name}_*"
+[ "$(cd "$(dirname "$scene")" 2>/dev/null && pwd)" = "$ref_key_root/data/$name" ] && glob="${name}_*"
 key=$(ref_key "$(dirname "$scene")" "$glob" "$(basename "$scene") $W $H $REF_SPP $REF_SAMPLER $extra")
 ref="$dir/$(basename "$(dirname "$scene")")_$(basename "$scene" .json)_$key.exr"
 if [ ! -f "$ref" ]; then
