@@ -7,6 +7,8 @@
 #   make clean    remove build outputs
 #   make fuzz           libFuzzer targets for every input parser (clang, build-fuzz/), FUZZ_SECONDS each (default 60)
 #   make test-sanitize  the whole test suite and small renders under ASan + UBSan (build-sanitize/)
+#   make test-tsan      ThreadSanitizer: renders and the threaded tests, with an instrumented oneTBB (build-tsan/;
+#                       about 20 minutes on 2 cores; fetches oneTBB's Debian source, so not part of make test)
 BUILD ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 PKGS := g++ make cmake pkg-config python3 libembree-dev libtinyobjloader-dev libstb-dev libpcg-cpp-dev catch2 \
@@ -44,7 +46,7 @@ golden: build
 	@tools/golden.sh $(BIN)
 
 clean:
-	rm -rf $(BUILD) $(FUZZ_BUILD) $(SANITIZE_BUILD)
+	rm -rf $(BUILD) $(FUZZ_BUILD) $(SANITIZE_BUILD) $(TSAN_BUILD)
 
 # ---- Robustness (issue 5): fuzzing and sanitizers, each in its own build folder. -----------------------------
 # make fuzz: installs clang + libFuzzer if missing, builds fuzz_{scene,obj,texture,image} (-DBAYESLIGHT_FUZZ=ON)
@@ -69,3 +71,10 @@ fuzz: fuzz-build
 # data/ scene with every sampler; prints how long each step took.
 test-sanitize: deps
 	tools/sanitize.sh $(SANITIZE_BUILD) $(JOBS)
+
+# make test-tsan: tools/tsan.sh (dpkg-dev unpacks the oneTBB source it fetches).
+TSAN_BUILD ?= build-tsan
+.PHONY: test-tsan
+test-tsan: deps
+	@$(MAKE) --no-print-directory deps PKGS="dpkg-dev"
+	tools/tsan.sh $(TSAN_BUILD) $(JOBS)
