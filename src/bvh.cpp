@@ -197,7 +197,7 @@ emitter_on_surface find_emitters_on_surfaces(const bvh_data& bvh, const scene_da
   tbb::parallel_for(size_t(0), emitters.size(), [&](size_t i) {
     const int e = emitters[i];
     on_surface_query q{&scene, &light_of_tri, e, {}, 0};
-    q.c = scene.tri_p0[size_t(e)] + (scene.tri_e1[size_t(e)] + scene.tri_e2[size_t(e)]) * (1.0f / 3);
+    q.c = triangle_centroid(scene, e);
     q.tol = min_ray_epsilon(scene, e, q.c);
     RTCPointQuery pq;
     pq.x = q.c.x, pq.y = q.c.y, pq.z = q.c.z;

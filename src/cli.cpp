@@ -4,6 +4,7 @@
 
 #include "bvh.h"
 #include "checkpoint.h"
+#include "cli_validators.h"
 #include "compare.h"
 #include "errors.h"
 #include "file_io.h"
@@ -15,11 +16,11 @@
 #include "render.h"
 #include "report.h"
 #include "scene.h"
+#include "scene_checks.h"
 #include "scene_desc.h"
+#include "version.h"
 
 #include <CLI/CLI.hpp>
-#include <embree3/rtcore_config.h>
-#include <oneapi/tbb/version.h>
 
 #include <unistd.h>
 
@@ -389,44 +390,7 @@ int run_render(const render_options& o) {
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
   loading.reset();
-  if (lights.count == 0)
-    std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", o.scene.c_str());
-  if (lights.tri_count > 0) {
-    // Rays leave a surface by at least 1e-6 of the largest coordinate there (what the hit point's rounding needs). A
-    // light whose size is below that, far from the origin, is stepped over: warn when that holds for the median
-    // light (the offset over the size, per light triangle at its centroid).
-    std::vector<float> ratio;
-    for (int t : lights.tri) {
-      vec3f c = scene.tri_p0[size_t(t)] + (scene.tri_e1[size_t(t)] + scene.tri_e2[size_t(t)]) * (1.0f / 3);
-      ratio.push_back(min_ray_epsilon(scene, t, c) / std::sqrt(scene.tri_area[size_t(t)]));
-    }
-    std::nth_element(ratio.begin(), ratio.begin() + ratio.size() / 2, ratio.end());
-    if (ratio[ratio.size() / 2] >= 1)
-      std::fprintf(stderr,
-                   "%s: warning: the lights are so far from the origin for their size that rays leave surfaces by "
-                   "%.3g times the median light's size: their light is lost (the image is too dark); move the "
-                   "scene nearer the origin\n",
-                   o.scene.c_str(), double(ratio[ratio.size() / 2]));
-  }
-  if (lights.tri_count > 0) {
-    emitter_on_surface on = find_emitters_on_surfaces(bvh, scene, lights.tri, lights.light_of_tri);
-    if (on.count > 0) {
-      const std::vector<material_data>& mats = scene.mesh.materials;
-      auto name = [&](int t) {
-        int m = scene.mesh.tri_materials[size_t(t)];
-        return m >= 0 && size_t(m) < mats.size() && !mats[size_t(m)].name.empty() ? "\"" + mats[size_t(m)].name + "\""
-                                                                              : std::string("the default material");
-      };
-      vec3f c = scene.tri_p0[size_t(on.emitter)] +
-                (scene.tri_e1[size_t(on.emitter)] + scene.tri_e2[size_t(on.emitter)]) * (1.0f / 3);
-      std::fprintf(stderr,
-                   "%s: warning: %d emitting triangle%s on another surface (%s at (%.6g, %.6g, %.6g) on a triangle "
-                   "of %s): rays meet either of two coincident faces, so the light near that surface differs between "
-                   "samplers and depths; move the emitter off the surface (by 1e-4 of the scene's size)\n",
-                   o.scene.c_str(), on.count, on.count == 1 ? " lies" : "s lie", name(on.emitter).c_str(), double(c.x),
-                   double(c.y), double(c.z), name(on.surface).c_str());
-    }
-  }
+  warn_about_lights(o.scene, scene, bvh, lights);
   if (!o.quiet) {
     auto t_end = std::chrono::steady_clock::now();
     std::fprintf(stderr, "%s: %zu triangles, %d lights%s; loaded in %.2f s, Embree BVH and lights in %.2f s\n",
@@ -604,64 +568,6 @@ int run_diff(const diff_options& o) {
   if (bit_identical(a, b)) std::printf("identical\n");
   return exit_ok;
 }
-
-// Rejects NaN and infinities: CLI::Range and CLI::PositiveNumber let NaN through (every comparison with it is false).
-// (decimal_number refuses "nan" and "inf" as text; this also catches a decimal that overflows, such as 1e400.)
-const CLI::Validator finite_number(
-    [](std::string& text) -> std::string {
-      char* end = nullptr;
-      double v = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || !std::isfinite(v)) return "Value " + text + " is not a finite number";
-      return {};
-    },
-    "");
-
-// A file name that is not empty: an empty shell variable (--log "$LOG") would otherwise drop the option silently.
-const CLI::Validator file_name(
-    [](std::string& text) -> std::string { return text.empty() ? "an empty file name" : std::string(); }, "");
-
-// Integers on the command line are decimal: CLI11 reads "064" as octal 52 and "0x10" as hex, so that a zero-padded
-// --spp silently rendered another count. Leading zeros are dropped ("064" is 64); a sign other than '-' (which
-// the ranges then refuse), a base prefix, spaces or a fraction are refused.
-const CLI::Validator decimal_integer(
-    [](std::string& text) -> std::string {
-      size_t digits = text.size() > 1 && text[0] == '-' ? 1 : 0;
-      if (digits == text.size() ||
-          text.find_first_not_of("0123456789", digits) != std::string::npos)
-        return "Value " + text + " is not a decimal integer";
-      size_t first = text.find_first_not_of('0', digits);
-      text.erase(digits, (first == std::string::npos ? text.size() - 1 : first) - digits);
-      return {};
-    },
-    "");
-
-// Decimal numbers likewise: strtod also reads "0x10" (16), "+0.5", " 2" and "inf", and a value that is not a number at
-// all ("1e", "0.5s") was reported as out of range. A plain decimal with an optional '-', fraction and exponent.
-const CLI::Validator decimal_number(
-    [](std::string& text) -> std::string {
-      auto digits = [&](size_t i) {
-        size_t j = i;
-        while (j < text.size() && text[j] >= '0' && text[j] <= '9') j++;
-        return j;
-      };
-      const size_t first = text.size() > 1 && text[0] == '-' ? 1 : 0;
-      const size_t int_end = digits(first);
-      size_t mantissa_end = int_end;
-      if (mantissa_end < text.size() && text[mantissa_end] == '.') mantissa_end = digits(mantissa_end + 1);
-      const bool mantissa = int_end > first || mantissa_end > int_end + 1;  // digits before or after the point
-      size_t end = mantissa_end;
-      if (mantissa && end < text.size() && (text[end] == 'e' || text[end] == 'E')) {
-        size_t e = end + 1;
-        if (e < text.size() && (text[e] == '-' || text[e] == '+')) e++;
-        size_t e_end = digits(e);
-        end = e_end > e ? e_end : std::string::npos;  // an exponent needs digits
-      }
-      if (!mantissa || end != text.size()) return "Value " + text + " is not a decimal number";
-      // "-0" is 0: the checkpoint fingerprint compares the values' bits, and a resume with -0 refused its own 0.
-      if (first == 1 && text.find_first_of("123456789", 1) >= mantissa_end) text.erase(0, 1);
-      return {};
-    },
-    "");
 
 // The options `render` and `compare` share: spp or time, size, depth, threads, seed, quiet, sampler options.
 void add_render_options(CLI::App* r, render_options& o) {
@@ -943,40 +849,6 @@ static int help_exit(CLI::App& app, const CLI::Error& e) {
     return exit_failure;
   }
   return status;
-}
-
-// bayeslight --version: what a bug report needs (the checkpoint format says which checkpoints this binary resumes).
-void print_version() {
-#ifndef BAYESLIGHT_VERSION
-#define BAYESLIGHT_VERSION "unknown"
-#define BAYESLIGHT_BUILD_TYPE "unknown"
-#endif
-#if defined(__clang__)
-  const std::string compiler = "clang " __clang_version__;
-#elif defined(__GNUC__)
-  const std::string compiler = "GCC " __VERSION__;
-#else
-  const std::string compiler = "an unknown compiler";
-#endif
-#if defined(__SANITIZE_ADDRESS__)
-  const char* sanitizers = ", AddressSanitizer";
-#elif defined(__SANITIZE_THREAD__)
-  const char* sanitizers = ", ThreadSanitizer";
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-  const char* sanitizers = ", AddressSanitizer";
-#elif __has_feature(thread_sanitizer)
-  const char* sanitizers = ", ThreadSanitizer";
-#else
-  const char* sanitizers = "";
-#endif
-#else
-  const char* sanitizers = "";
-#endif
-  std::printf("bayeslight %s\ncheckpoint format %u\nbuilt with %s (%s%s; -ffp-contract=off, no fast-math, no host-specific "
-              "instructions), Embree %s, oneTBB %s\n",
-              BAYESLIGHT_VERSION, unsigned(checkpoint_format_version()), compiler.c_str(), BAYESLIGHT_BUILD_TYPE,
-              sanitizers, RTC_VERSION_STRING, TBB_VERSION_STRING);
 }
 
 int run_cli(int argc, char** argv) {

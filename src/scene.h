@@ -54,6 +54,10 @@ struct surface_point {
 inline vec3f interpolated_point(const scene_data& scene, int tri, float b1, float b2) {
   return scene.tri_p0[size_t(tri)] + scene.tri_e1[size_t(tri)] * b1 + scene.tri_e2[size_t(tri)] * b2;
 }
+// The centroid of triangle tri.
+inline vec3f triangle_centroid(const scene_data& scene, int tri) {
+  return scene.tri_p0[size_t(tri)] + (scene.tri_e1[size_t(tri)] + scene.tri_e2[size_t(tri)]) * (1.0f / 3);
+}
 // Point p, at barycentrics (b1, b2) of triangle tri, seen by a ray with direction `dir`.
 surface_point eval_surface(const scene_data& scene, int tri, float b1, float b2, vec3f p, vec3f dir);
 // Barycentric point (b1, b2) of triangle tri seen by a ray with direction `dir`.
