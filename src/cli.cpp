@@ -309,6 +309,12 @@ void warn_after_scene(const render_options& o, const render_params& params, cons
                  unused.c_str());
 }
 
+// "frame A was" or "frames A to B were": an animation's frames in a message.
+std::string frames_were(int a, int b) {
+  return a == b ? "frame " + std::to_string(a) + " was"
+                : "frames " + std::to_string(a) + " to " + std::to_string(b) + " were";
+}
+
 int run_render(const render_options& o) {
   install_interrupt_handlers();  // (a signal while the scene loads ends the command at once)
   sampler_kind kind;
@@ -420,12 +426,13 @@ int run_render(const render_options& o) {
         std::string missing;
         int count = 0;
         for (int f = 0; f < r.frame; f++)
-          for (const std::string& out : outputs)
-            if (!fs::exists(frame_path(out, f, animated)) && count++ == 0) missing = frame_path(out, f, animated);
+          for (const std::string& out : outputs) {
+            std::string file = frame_path(out, f, animated);
+            if (!fs::exists(file) && count++ == 0) missing = file;
+          }
         if (count > 0 || !o.quiet)
           std::fprintf(stderr, "%s: resuming the animation at frame %d of %d (%s rendered before)%s\n",
-                       o.resume.c_str(), r.frame, params.frames,
-                       r.frame == 1 ? "frame 0 was" : ("frames 0 to " + std::to_string(r.frame - 1) + " were").c_str(),
+                       o.resume.c_str(), r.frame, params.frames, frames_were(0, r.frame - 1).c_str(),
                        count == 0 ? ""
                                   : ("; warning: " + missing +
                                      (count > 1 ? " and " + std::to_string(count - 1) + " more of those frames' files are"
@@ -534,10 +541,7 @@ int run_render(const render_options& o) {
   // A signal that came after the last pass (while the outputs were written) still ends the run as interrupted.
   if (interrupted || interrupt_signal() != 0) {
     int sig = interrupt_signal();
-    // The frames after last_frame, as a phrase.
-    const std::string rest = last_frame + 2 == params.frames ? "frame " + std::to_string(last_frame + 1) + " was"
-                             : "frames " + std::to_string(last_frame + 1) + " to " + std::to_string(params.frames - 1) +
-                                   " were";
+    const std::string rest = frames_were(last_frame + 1, params.frames - 1);  // (the frames after last_frame)
     if (interrupted && params.frames > 1)  // (in an animation's frame: say what is left, and how to go on)
       std::fprintf(stderr, "bayeslight: the animation stopped in frame %d of %d%s%s\n", last_frame, params.frames,
                    last_frame + 1 < params.frames ? ("; " + rest + " not rendered").c_str() : "",
