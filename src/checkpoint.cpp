@@ -343,6 +343,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.value(scene.sun.angular_diameter_deg), h.value(scene.two_sided_emitters);
   h.value(p.width), h.value(p.height), h.value(p.max_depth), h.value(p.seed), h.value(int(p.sampler.kind));
   h.value(p.stratify);
+  if (p.light_samples != 1) h.value(p.light_samples);  // (one: the fingerprint of checkpoints from before the option)
   const sampler_kind k = p.sampler.kind;
   if (p.frames > 1) {
     // An animation: its frame count and the sun's end (each frame's sun), and, for a learning sampler, how much of

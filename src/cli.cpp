@@ -71,6 +71,7 @@ struct render_options {
   double frame_decay = 0.5;
   double pass_weighting = 4;
   bool independent = false;
+  int light_samples = 1;
   std::string checkpoint;
   double checkpoint_every = 30;
   std::string resume;
@@ -191,6 +192,7 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.frame_decay = o.frame_decay;
   p.pass_weighting = o.pass_weighting;
   p.stratify = !o.independent;
+  p.light_samples = o.light_samples;
   p.progress = p.notes = !o.quiet && stderr_is_terminal();
   return p;
 }
@@ -584,6 +586,9 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "Path length in segments; 1 = direct illumination only (camera ray, NEE and emission seen), 2 adds "
                 "one bounce (default: the scene's render.max_depth)")
       ->check(CLI::Range(1, 1000));
+  r->add_option("--light-samples", o.light_samples,
+                "NEE samples at every path vertex, each its own light, point and shadow ray, averaged (default 1)")
+      ->check(CLI::Range(1, 64));
   r->add_option("--threads", o.threads, "Worker threads (default: all cores); never changes the image")
       ->check(CLI::Range(1, 4096));
   r->add_option_function<std::string>(

@@ -41,6 +41,9 @@ struct render_inputs {
   // of a pass depend on no earlier sample that its model learned from (which keeps the estimator unbiased).
   bool stratify = true;
   uint64_t stratum_base = 0, stratum_key = 0;
+  // NEE samples per vertex (light choice, point and shadow ray each; the point's pmf built once): their mean is the
+  // vertex's NEE estimate, MIS-weighted as nee_samples draws against one BSDF draw.
+  int nee_samples = 1;
 };
 
 // Counters of one worker's share of a pass (summed in a fixed order afterwards).
@@ -149,8 +152,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       if (in_sun_disk(lights, dir)) {
         float w = 1;
         if (prev_mis)
-          w = power_heuristic(prev_bsdf_pdf,
-                              sampler.pmf(ctxs[(depth - 1) & 1], lights.sun) * cone_pdf(lights.sun_one_minus_cos));
+          w = power_heuristic(prev_bsdf_pdf, float(in.nee_samples) * sampler.pmf(ctxs[(depth - 1) & 1], lights.sun) *
+                                                 cone_pdf(lights.sun_one_minus_cos));
         radiance += beta * lights.sun_radiance * w;
       }
       break;
@@ -164,7 +167,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
         float w = 1;
         if (prev_mis) {
           float cos_l = std::fabs(dot(scene.tri_ng[h.tri], dir));
-          float light_pdf = sampler.pmf(ctxs[(depth - 1) & 1], hit_light) *
+          float light_pdf = float(in.nee_samples) * sampler.pmf(ctxs[(depth - 1) & 1], hit_light) *
                             triangle_light_pdf(scene, lights, hit_light, org, h.t, cos_l);
           w = power_heuristic(prev_bsdf_pdf, light_pdf);
         }
@@ -193,16 +196,27 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     sampler.prepare(ctx, spt);
     tm.stop(prof_pmf, t0);
 
-    // Next-event estimation.
-    t0 = tm.start();
-    light_choice choice = sampler.sample(ctx, r.u53(dim_light_select, dim_light_select_lo),
-                                         r.u53(dim_light_inner, dim_light_inner_lo));
-    tm.stop(prof_select, t0);
-    if (choice.light != invalid_id && choice.prob > 0) {
+    // Next-event estimation: nee_samples draws, each its own light choice, point and shadow ray.
+    const int n_nee = in.nee_samples;
+    const float inv_n = 1.0f / float(n_nee);
+    for (int k = 0; k < n_nee; k++) {
+      vertex_randoms rk_own;
+      const vertex_randoms* rk = &r;
+      if (n_nee > 1) {
+        if (k > 0) rk_own = draw_vertex(key, uint32_t(depth) | (uint32_t(k) << 20)), rk = &rk_own;
+        else rk_own = r, rk = &rk_own;
+        if (depth == 1 && in.stratify)
+          stratify_light_with(ps.strata, uint32_t((sample - in.stratum_base) * uint64_t(n_nee) + uint64_t(k)), rk_own);
+      }
+      t0 = tm.start();
+      light_choice choice = sampler.sample(ctx, rk->u53(dim_light_select, dim_light_select_lo),
+                                           rk->u53(dim_light_inner, dim_light_inner_lo));
+      tm.stop(prof_select, t0);
+      if (!(choice.light != invalid_id && choice.prob > 0)) continue;
       st.nee_samples++;
       float value = 0, added = 0, added_total = 0;
       t0 = tm.start();
-      light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, r.u[dim_light_u], r.u[dim_light_v]);
+      light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, rk->u[dim_light_u], rk->u[dim_light_v]);
       vec3f fc = ls.pdf > 0 ? eval_bsdf_cos(bsdf, wo, ls.wi) : vec3f{0, 0, 0};
       tm.stop(prof_point, t0);
       if (ls.pdf > 0) {
@@ -213,8 +227,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
           tm.stop(prof_shadow, t0);
           if (visible) {
             vec3f unweighted = fc * ls.le / ls.pdf;
-            float w = last ? 1.0f : power_heuristic(choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
-            vec3f add = beta * unweighted * (w / choice.prob);
+            float w = last ? 1.0f : power_heuristic(float(n_nee) * choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
+            vec3f add = beta * unweighted * (w * inv_n / choice.prob);
             radiance += add;
             value = luminance(unweighted) / choice.prob_in_cluster;
             added = added_total = luminance(add);
@@ -223,10 +237,11 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       }
       if constexpr (has_control_variates<Sampler>::value) {
         // Control variate (unweighted NEE only): sum_j c_j + (Y_J - c_J) / P_J, the Y_J / P_J part added above;
-        // c_j in colour is the cluster's learned albedo-free mean times (kd + ks) / pi.
+        // c_j in colour is the cluster's learned albedo-free mean times (kd + ks) / pi. (Over nee_samples draws the
+        // sum is added once: each draw adds its share.)
         if (ctx.cv) {
           vec3f c = sampler.cv_total(ctx) - sampler.cv_cluster(ctx, choice.cluster) * float(1 / choice.cluster_prob);
-          vec3f add = beta * (bsdf.kd + bsdf.ks) * inv_pi_f * c;
+          vec3f add = beta * (bsdf.kd + bsdf.ks) * inv_pi_f * c * inv_n;
           radiance += add;
           added_total += luminance(add);
         }

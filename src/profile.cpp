@@ -137,7 +137,9 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
     out += buf;
   };
   line("profile of %s\n", title.c_str());
-  line("  %dx%d, %d spp, max depth %d, %d threads\n", params.width, params.height, a.spp, params.max_depth, threads);
+  line("  %dx%d, %d spp, max depth %d, %d threads", params.width, params.height, a.spp, params.max_depth, threads);
+  if (params.light_samples > 1) line(", %d light samples per vertex", params.light_samples);
+  line("\n");
   double rays_total = double(st.camera_rays + st.shadow_rays + st.bounce_rays);
   line("  plain render: %.3f s in %d passes; %.3f M NEE samples (%.2f M/s); %.2f M rays/s (camera %.2f M, shadow "
        "%.2f M, bounce %.2f M)\n",

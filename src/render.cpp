@@ -406,6 +406,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   in.max_depth = params.max_depth;
   in.seed = params.seed;
   in.stratify = params.stratify;
+  in.nee_samples = std::max(1, params.light_samples);
   int frames = std::max(1, params.frames);
   // The set-up (light tree, the regions of the first hits) runs on at most --threads threads too.
   int threads = params.threads > 0 ? params.threads : int(std::max(1u, std::thread::hardware_concurrency()));

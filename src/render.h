@@ -39,6 +39,7 @@ struct render_params {
   // Adaptive samplers (bayes, donikian): the samples of a pass taken after n spp count pass_weight(n, this)
   // times in the image (0: all alike). Fixed in advance, so the weighted mean stays unbiased.
   double pass_weighting = 4;
+  int light_samples = 1;      // NEE samples per path vertex (render_inputs::nee_samples)
   bool stratify = true;       // stratified light and BSDF samples at the first vertex (integrator.h)
   // A signal arriving during the render's first pass (frame 0, not resumed) lets that pass finish, so that there is an
   // image to write, and the render then stops; a second one, half a second or more later, stops it at once. (The

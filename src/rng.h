@@ -185,12 +185,16 @@ inline stratum_hashes stratum_hashes_of(uint64_t key, uint64_t pixel) {
   uint64_t k = mix64(key ^ pixel);
   return {mix64(k + 1), mix64(k + 2), mix64(k + 3)};
 }
-inline void stratify_with(const stratum_hashes& hs, uint32_t index, bool last, vertex_randoms& r) {
+// The light dimensions (light choice, point on the light) of stratify_with; alone, for a vertex's further NEE draws.
+inline void stratify_light_with(const stratum_hashes& hs, uint32_t index, vertex_randoms& r) {
   r.raw[dim_light_select] = shuffled_vdc(index, hs.select);
   sobol_pair(index, hs.point, r.raw[dim_light_u], r.raw[dim_light_v]);
   r.u[dim_light_select] = uint_to_unit(r.raw[dim_light_select]);
   r.u[dim_light_u] = uint_to_unit(r.raw[dim_light_u]);
   r.u[dim_light_v] = uint_to_unit(r.raw[dim_light_v]);
+}
+inline void stratify_with(const stratum_hashes& hs, uint32_t index, bool last, vertex_randoms& r) {
+  stratify_light_with(hs, index, r);
   if (last) return;
   sobol_pair(index, hs.bsdf, r.raw[dim_bsdf_u], r.raw[dim_bsdf_v]);
   r.u[dim_bsdf_u] = uint_to_unit(r.raw[dim_bsdf_u]);

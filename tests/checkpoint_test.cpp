@@ -205,6 +205,7 @@ TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[ch
   REQUIRE(run_bayeslight(base_args("bayes") + " -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
   for (const std::string& other : {base_args("bayes") + " --seed 5", base_args("bayes") + " --max-depth 2",
                                    base_args("bound"), base_args("bayes") + " --bayes-b0 2",
+                                   base_args("bayes") + " --light-samples 2",
                                    "render " + source_path("data/cornell/path.json") +
                                        " --sampler bayes --width 40 --height 30 --spp 30 --quiet"}) {
     auto r = run_bayeslight(other + " -o " + (d / "x.pfm") + " --resume " + ck);

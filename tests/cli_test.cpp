@@ -242,6 +242,8 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
        "--out: an empty file name"},
       {"render " + s.json + " --spp 4 --time 1", "--time"},
       {"render " + s.json + " --threads 0", "--threads"},
+      {"render " + s.json + " --light-samples 0", "--light-samples"},
+      {"render " + s.json + " --light-samples 65", "--light-samples"},
       {"render " + s.json + " --max-depth 0", "--max-depth"},
       {"render " + s.json + " --width 0", "--width"},
       {"render " + s.json + " --width 1000000 --height 1000000", "--width"},

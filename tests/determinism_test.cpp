@@ -37,6 +37,9 @@ TEST_CASE("one and two threads give byte identical files for every sampler", "[d
   for (const char* s : samplers) runs.push_back({s, s, "data/living_room/path.json"});
   runs.push_back({"bayes_direct", "bayes --max-depth 1", "data/living_room/path.json"});
   runs.push_back({"bayes_glossy", "bayes", "data/plant_room/direct.json"});
+  // Several light samples per vertex: each draw records its own observation, in the same order for any thread count.
+  runs.push_back({"bayes_light_samples", "bayes --light-samples 3", "data/living_room/path.json"});
+  runs.push_back({"donikian_light_samples", "donikian --light-samples 3", "data/living_room/path.json"});
   for (const auto& [label, s, scene] : runs) {
     std::string a = d / (label + "_1.exr"), b = d / (label + "_2.exr");
     std::string pa = d / (label + "_1.pfm"), pb = d / (label + "_2.pfm");
