@@ -68,6 +68,40 @@ double under_square_lamp(double a, double h, double le, double rho) {
   return rho / M_PI * 4 * le * s * std::atan(s);
 }
 
+// A Lambertian floor of albedo rho, a square emitter of side 2a and radiance le at height h facing it, and a small
+// quad of radiance other_le high up facing away (it never lights the floor, but the samplers that trust power or
+// bounds still spend draws on it).
+mesh_data square_lamp_mesh(float a, float h, float le, float rho, float other_le) {
+  mesh_builder b;
+  int floor = b.add_material({rho, rho, rho});
+  int lamp = b.add_material({0, 0, 0}, {le, le, le});
+  int other = b.add_material({0, 0, 0}, {other_le, other_le, other_le});
+  b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
+  b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);  // normal -y: faces the floor
+  b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, other);     // faces up: never lights the floor
+  return b.mesh;
+}
+
+// A Lambertian floor of albedo rho under the sun (direction dir, irradiance e, angular diameter deg), with a quad of
+// radiance lamp_le high up facing away from it.
+struct sunlit_floor {
+  mesh_data mesh;
+  sun_params sun;
+};
+sunlit_floor sunlit_floor_of(float rho, float lamp_le, vec3f dir, float e, float deg) {
+  mesh_builder b;
+  int floor = b.add_material({rho, rho, rho});
+  int lamp = b.add_material({0, 0, 0}, {lamp_le, lamp_le, lamp_le});
+  b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
+  b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, lamp);  // faces up: never lights the floor
+  sun_params sun;
+  sun.enabled = true;
+  sun.direction = dir;
+  sun.irradiance = {e, e, e};
+  sun.angular_diameter_deg = deg;
+  return {b.mesh, sun};
+}
+
 const sampler_kind kinds[] = {sampler_kind::uniform, sampler_kind::power,    sampler_kind::bvh,
                               sampler_kind::bound,   sampler_kind::donikian, sampler_kind::bayes};
 
@@ -78,16 +112,11 @@ TEST_CASE("a point under a large emitting square receives the closed form irradi
   const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
   for (sampler_kind kind : kinds)
     for (int depth : {1, 2}) {
-      mesh_builder b;
-      int floor = b.add_material({rho, rho, rho});
-      int lamp = b.add_material({0, 0, 0}, {le, le, le});
-      int dim = b.add_material({0, 0, 0}, {0.1f, 0.1f, 0.1f});
-      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
-      b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);  // normal -y: faces the floor
-      b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, dim);       // faces up: never lights the floor
       double exact = under_square_lamp(a, h, le, rho);
       INFO("sampler " << sampler_name(kind) << " depth " << depth);
-      check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, depth, 1024), exact);
+      check_estimate(render_pixels(square_lamp_mesh(a, h, le, rho, 0.1f), looking_down(h / 2), {}, false, kind, depth,
+                                   1024),
+                     exact);
     }
 }
 
@@ -337,21 +366,12 @@ TEST_CASE("the sun lights a floor with its irradiance times the cosine", "[analy
   vec3f dir = normalize(vec3f{0.3f, 1.0f, 0.2f});
   for (sampler_kind kind : kinds)
     for (int depth : {1, 2}) {
-      mesh_builder b;
-      int floor = b.add_material({rho, rho, rho});
       // A lamp facing up (no contribution) with about the sun's power, so that light selection matters and
       // the wasted samples are frequent enough for the pixel variance to show them.
-      int lamp = b.add_material({0, 0, 0}, {3000, 3000, 3000});
-      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
-      b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, lamp);
-      sun_params sun;
-      sun.enabled = true;
-      sun.direction = dir;
-      sun.irradiance = {e_sun, e_sun, e_sun};
-      sun.angular_diameter_deg = 0.53f;
+      sunlit_floor f = sunlit_floor_of(rho, 3000, dir, e_sun, 0.53f);
       double exact = rho / M_PI * e_sun * dir.y;
       INFO("sampler " << sampler_name(kind) << " depth " << depth);
-      check_estimate(render_pixels(b.mesh, looking_down(1), sun, false, kind, depth, 512), exact);
+      check_estimate(render_pixels(f.mesh, looking_down(1), f.sun, false, kind, depth, 512), exact);
     }
 }
 
@@ -363,33 +383,18 @@ TEST_CASE("several light samples per vertex average to the closed form, MIS weig
   const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
   for (sampler_kind kind : kinds)
     for (int depth : {1, 2}) {
-      mesh_builder b;
-      int floor = b.add_material({rho, rho, rho});
-      int lamp = b.add_material({0, 0, 0}, {le, le, le});
-      int dim = b.add_material({0, 0, 0}, {0.1f, 0.1f, 0.1f});
-      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
-      b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);
-      b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, dim);
       INFO("square lamp, sampler " << sampler_name(kind) << " depth " << depth);
-      check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, depth, 384, 8, 1, 3),
+      check_estimate(render_pixels(square_lamp_mesh(a, h, le, rho, 0.1f), looking_down(h / 2), {}, false, kind, depth,
+                                   384, 8, 1, 3),
                      under_square_lamp(a, h, le, rho));
     }
   const float e_sun = 3.0f;
   const vec3f dir = normalize(vec3f{0.3f, 1.0f, 0.2f});
   for (sampler_kind kind : kinds)
     for (int depth : {1, 2}) {
-      mesh_builder b;
-      int floor = b.add_material({rho, rho, rho});
-      int lamp = b.add_material({0, 0, 0}, {0.2f, 0.2f, 0.2f});
-      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
-      b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, lamp);  // faces up: never lights the floor
-      sun_params sun;
-      sun.enabled = true;
-      sun.direction = dir;
-      sun.irradiance = {e_sun, e_sun, e_sun};
-      sun.angular_diameter_deg = 40;  // all above the horizon: E = E_sun cos(theta_s) still
+      sunlit_floor f = sunlit_floor_of(rho, 0.2f, dir, e_sun, 40);  // 40 degrees, all above the horizon: E_sun cos
       INFO("sun, sampler " << sampler_name(kind) << " depth " << depth);
-      check_estimate(render_pixels(b.mesh, looking_down(1), sun, false, kind, depth, 384, 8, 1, 3),
+      check_estimate(render_pixels(f.mesh, looking_down(1), f.sun, false, kind, depth, 384, 8, 1, 3),
                      rho / M_PI * e_sun * dir.y);
     }
 }
@@ -400,16 +405,10 @@ TEST_CASE("light samples per vertex are drawn apart: four cut the pixels' spread
   // standard deviation with four draws against one, at the same spp. Independent draws give 1/2 (stratified, less);
   // the bound 0.7 leaves the spread's own sampling error (64 pixels: about 9 % each) more than 3 sigma.
   const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
+  const mesh_data mesh = square_lamp_mesh(a, h, le, rho, 50);
   for (sampler_kind kind : kinds) {
-    mesh_builder b;
-    int floor = b.add_material({rho, rho, rho});
-    int lamp = b.add_material({0, 0, 0}, {le, le, le});
-    int away = b.add_material({0, 0, 0}, {50, 50, 50});
-    b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
-    b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);
-    b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, away);
-    mean_se one = mean_and_se(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, 1, 16, 8, 3, 1));
-    mean_se four = mean_and_se(render_pixels(b.mesh, looking_down(h / 2), {}, false, kind, 1, 16, 8, 3, 4));
+    mean_se one = mean_and_se(render_pixels(mesh, looking_down(h / 2), {}, false, kind, 1, 16, 8, 3, 1));
+    mean_se four = mean_and_se(render_pixels(mesh, looking_down(h / 2), {}, false, kind, 1, 16, 8, 3, 4));
     INFO("sampler " << sampler_name(kind) << " se with 1: " << one.se << " with 4: " << four.se);
     CHECK(one.se > 0);
     CHECK(four.se < 0.7 * one.se);
