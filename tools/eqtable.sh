@@ -2,7 +2,8 @@
 # Equal-time table: every sampler on every data/ scene (direct and path traced) for T seconds against a cached
 # high-sample reference, with the speed-up of bayes over bound and over bvh (relMSE ratio at equal time).
 #   tools/eqtable.sh BIN   (env: T seconds per render, W H image size, SCENES, MODES, SAMPLERS, REF_SPP_DIRECT,
-#                           REF_SPP_PATH, REF_SAMPLER; references cached in $(dirname BIN)/ref)
+#                           REF_SPP_PATH, REF_SAMPLER, OPTS: options added to every timed render, e.g.
+#                           OPTS="--light-samples 2"; references cached in $(dirname BIN)/ref)
 # A cached reference's name carries a hash of the scene's files and of its golden images in that mode (ref_key.sh):
 # a change to the scene, or one of the renderer that changes images, renders a new reference.
 # References: REF_SAMPLER (default bayes: the lowest-variance unbiased sampler here, so its reference adds the least
@@ -43,8 +44,9 @@ for scene in $SCENES; do
     row="| $scene | $mode |"
     declare -A err=()
     for s in $SAMPLERS; do
+      # shellcheck disable=SC2086  # OPTS: words on purpose
       "$bin" render "$json" --sampler "$s" --time "$T" --width "$W" --height "$H" --reference "$ref" \
-        --log "$tmp/$s.csv" -o "$tmp/$s.exr" --quiet
+        --log "$tmp/$s.csv" -o "$tmp/$s.exr" --quiet ${OPTS:-}
       # A --time render finishes the pass under way at T (up to 64 spp more): the error and spp at exactly T are
       # interpolated between the last pass before T and the first at or after it (log-log for the error).
       read -r e n < <(awk -F, -v T="$T" '$1 != "sampler" {
