@@ -174,6 +174,9 @@ bool on_surface_candidate(RTCPointQueryFunctionArguments* args) {
   const int t = int(args->primID);
   const scene_data& s = *q->scene;
   if (q->found != invalid_id || t == q->emitter || (*q->light_of_tri)[size_t(t)] != invalid_id) return false;
+  // The emitter's reversed twin (a lamp written back to back with a face of another material) is the other face of
+  // one sheet: a ray meets the face turned toward it (intersect), nothing random there.
+  if (!s.tri_twin.empty() && (s.tri_twin[size_t(q->emitter)] == t || s.tri_twin[size_t(t)] == q->emitter)) return false;
   const vec3f n = s.tri_ng[size_t(t)], v = q->c - s.tri_p0[size_t(t)];
   if (std::fabs(dot(n, s.tri_ng[size_t(q->emitter)])) < 0.9999f || std::fabs(dot(n, v)) > q->tol) return false;
   // c's barycentrics in t's plane.

@@ -349,12 +349,15 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
   const std::string args = base + " --frames 3";
   REQUIRE(run_bayeslight(args + " --checkpoint " + ck + " --stop-after-passes 17").status == 130);
   CHECK(run_bayeslight(base + " --frames 4 --resume " + ck).status == 3);
-  CHECK(run_bayeslight(args + " --frame-decay 0.7 --resume " + ck).status == 3);
+  auto decay = run_bayeslight(args + " --frame-decay 0.7 --resume " + ck);
+  CHECK(decay.status == 3);
+  CHECK(decay.output.find("--frame-decay)") != std::string::npos);  // (the message named every option but this one)
   // Nor with other samples per frame: frame 0 was rendered with 27 spp and frame 1 learned from it.
   auto more = run_bayeslight("render " + anim + " --spp 40 --frames 3 --quiet -o " + (a.dir / "part_%d.pfm") +
                              " --resume " + ck);
   CHECK(more.status == 3);
-  CHECK(more.output.find("(an animation's also for another --frames, --spp or --time)") != std::string::npos);
+  CHECK(more.output.find("(an animation's also for another --frames, --spp, --time or --frame-decay)") !=
+        std::string::npos);
   CHECK(run_bayeslight("render " + anim + " --spp 27 --quiet -o " + (a.dir / "still.pfm") + " --resume " + ck).status == 3);
   // The frame index (after magic, version, fingerprint, reference hash, sampler kind, width and height) edited out of
   // range and the file re-sealed with its checksum: refused, never followed.
