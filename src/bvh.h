@@ -44,18 +44,19 @@ hit_info intersect(const bvh_data& bvh, vec3f org, vec3f dir, float tmax = inf_f
 // Whether anything blocks the segment org + t*dir, t in (0, tmax).
 bool occluded(const bvh_data& bvh, vec3f org, vec3f dir, float tmax);
 
-// Emitter triangles that lie on another surface: a triangle that emits nothing, parallel to the emitter, whose plane
-// passes within rounding (min_ray_epsilon) of the emitter's centroid and which holds that point (not in a cut-out
-// hole). Rays meet either of two coincident faces (Embree reports one at the same distance), while a shadow ray ends
-// off the emitter in front of both: such a lamp's light near the surface depends on the sampler and the depth (a
-// review: 18 % less path traced than in direct illumination). `emitters`: the emitting triangles; `light_of_tri`: per
-// triangle, its light or invalid_id. Returns how many emitters do, and one of them with the surface it lies on.
+// Emitter triangles that lie on another surface: a triangle parallel to the emitter, other than the emitter's reversed
+// twin (the other face of one sheet, which rays resolve), whose plane passes within rounding (min_ray_epsilon) of the
+// emitter's centroid and which holds that point (not in a cut-out hole); an emitting one too. Rays meet either of two
+// coincident faces (Embree reports one at the same distance), while a shadow ray ends off the emitter in front of
+// both: such a lamp's light near the surface depends on the sampler and the depth (a review: 18 % less path traced
+// than in direct illumination); a lamp over a lamp is sampled as both and seen as either. `emitters`: the emitting
+// triangles. Returns how many emitters do, and one of them with the surface it lies on.
 struct emitter_on_surface {
   int count = 0;
   int emitter = invalid_id, surface = invalid_id;
 };
 emitter_on_surface find_emitters_on_surfaces(const bvh_data& bvh, const scene_data& scene,
-                                             const std::vector<int>& emitters, const std::vector<int>& light_of_tri);
+                                             const std::vector<int>& emitters);
 
 // Our own ray/triangle distance and barycentrics (Moller-Trumbore in float), clamped onto the triangle, and the point
 // (hit_info: on a triangle far larger than the ray's scale, distance and point from the exact corners' plane in double).

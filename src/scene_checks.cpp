@@ -29,7 +29,7 @@ void warn_about_lights(const std::string& name, const scene_data& scene, const b
                    name.c_str(), double(ratio[ratio.size() / 2]));
   }
   if (lights.tri_count > 0) {
-    emitter_on_surface on = find_emitters_on_surfaces(bvh, scene, lights.tri, lights.light_of_tri);
+    emitter_on_surface on = find_emitters_on_surfaces(bvh, scene, lights.tri);
     if (on.count > 0) {
       const std::vector<material_data>& mats = scene.mesh.materials;
       auto material_of = [&](int t) {
