@@ -414,3 +414,20 @@ TEST_CASE("light samples per vertex are drawn apart: four cut the pixels' spread
     CHECK(four.se < 0.7 * one.se);
   }
 }
+
+TEST_CASE("a two-sided lamp lights the floor its back faces, with every sampler", "[analytic]") {
+  // two_sided_emitters: a single sheet emits from both faces. A square lamp facing up, away from the floor, lights it
+  // with its back: the light tree's normal cones, the bounds and the samplers' pmfs must all count that side.
+  const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
+  for (sampler_kind kind : kinds)
+    for (int depth : {1, 2}) {
+      mesh_builder b;
+      int floor = b.add_material({rho, rho, rho});
+      int lamp = b.add_material({0, 0, 0}, {le, le, le});
+      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
+      b.add_quad({-a, h, -a}, {-a, h, a}, {a, h, a}, {a, h, -a}, lamp);  // normal +y: faces away from the floor
+      INFO("sampler " << sampler_name(kind) << " depth " << depth);
+      check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, true, kind, depth, 512),
+                     under_square_lamp(a, h, le, rho));
+    }
+}

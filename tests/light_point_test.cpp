@@ -368,3 +368,22 @@ TEST_CASE("no solid-angle sample is lost beside a lamp's edge line", "[lights]")
       CHECK(std::fabs(m.mean - exact) < 4.4 * m.se);
     }
 }
+
+TEST_CASE("an emitter's power counts the faces it emits from", "[lights]") {
+  // Power (power sampling, the light tree's intensity behind it) is luminance(Le) * area * pi per emitting face: twice
+  // that for a two-sided emitter, once for each face of a sheet (a face and its reverse, each emitting from its
+  // front only).
+  const vec3f p0{0, 0, 0}, p1{2, 0, 0}, p2{0, 0, 3};  // area 3
+  const double one_face = 2.0 * 3.0 * M_PI;
+  one_triangle one_sided(p0, p1, p2, false, 2), two_sided(p0, p1, p2, true, 2);
+  CHECK(one_sided.lights.power[0] == Approx(one_face).epsilon(1e-6));
+  CHECK(two_sided.lights.power[0] == Approx(2 * one_face).epsilon(1e-6));
+  mesh_builder b;
+  int lamp = b.add_material({0, 0, 0}, {2, 2, 2});
+  b.add_triangle(p0, p1, p2, lamp);
+  b.add_triangle(p2, p1, p0, lamp);
+  scene_data sheet = build_scene(std::move(b.mesh), camera_params{}, sun_params{}, true, 1.0f);
+  light_data sheet_lights = build_lights(sheet);
+  REQUIRE(sheet_lights.power.size() == 2);
+  for (float pw : sheet_lights.power) CHECK(pw == Approx(one_face).epsilon(1e-6));
+}

@@ -1,6 +1,7 @@
 // Tests of sampling warps against their pdfs (chi-square of histograms against the pdf integrated per
 // cell, nori style) and of discrete distributions. Every test is seeded; significance 1e-3 per test.
 #include "lights.h"
+#include "material.h"
 #include "rng.h"
 #include "sampling.h"
 #include "test_util.h"
@@ -236,4 +237,50 @@ TEST_CASE("directions fall in the sun's disk with its solid angle, for disks dow
     INFO("diameter " << diameter_deg << " degrees: " << inside << " of " << n << " inside, expected " << p * n);
     CHECK(std::fabs(double(inside) / n - p) < 4.4 * se);
   }
+}
+
+namespace {
+// The directional albedo at normal incidence (wo along the normal) of b, by midpoint quadrature over the polar angle
+// (the lobe is symmetric about the normal there): 2 pi * integral of f cos(theta) sin(theta) dtheta.
+double albedo_at_normal_incidence(const bsdf_data& b) {
+  const int steps = 200000;
+  const double dt = 0.5 * M_PI / steps;
+  double sum = 0;
+  for (int i = 0; i < steps; i++) {
+    double t = (i + 0.5) * dt;
+    vec3f wi = {float(std::sin(t)), 0, float(std::cos(t))};
+    sum += double(eval_bsdf_cos(b, {0, 0, 1}, wi).x) * std::sin(t) * dt;  // (eval_bsdf_cos includes the cosine)
+  }
+  return 2 * M_PI * sum;
+}
+bsdf_data facing_up(vec3f kd, vec3f ks, float ns) {
+  bsdf_data b;
+  b.kd = kd, b.ks = ks, b.ns = ns;
+  b.spec_prob = luminance(ks) > 0 ? luminance(ks) / (luminance(kd) + luminance(ks)) : 0;
+  b.frame = make_frame({0, 0, 1});
+  b.ng = {0, 0, 1};
+  return b;
+}
+}  // namespace
+
+TEST_CASE("the normalized Phong lobe reflects ks at normal incidence, and Lambert kd", "[sampling]") {
+  // f = ks (n + 2) / (2 pi) cos^n(alpha): at normal incidence the mirror direction is the normal and the integral of
+  // f cos over the hemisphere is ks exactly, for every exponent.
+  for (float n : {0.0f, 1.0f, 10.0f, 100.0f, 1000.0f}) {
+    INFO("exponent " << n);
+    CHECK(albedo_at_normal_incidence(facing_up({0, 0, 0}, {0.7f, 0.7f, 0.7f}, n)) == Approx(0.7).epsilon(2e-4));
+  }
+  CHECK(albedo_at_normal_incidence(facing_up({0.6f, 0.6f, 0.6f}, {0, 0, 0}, 1)) == Approx(0.6).epsilon(2e-4));
+}
+
+TEST_CASE("a material whose Kd + Ks exceed one is scaled to reflect at most all light", "[sampling]") {
+  // Kd 0.8 + Ks 0.6 (the loader warns): both scaled by 1 / 1.4, so the albedo at normal incidence is 1, not 1.4.
+  mesh_builder mb;
+  int m = mb.add_material({0.8f, 0.8f, 0.8f}, {0, 0, 0}, {0.6f, 0.6f, 0.6f}, 20);
+  mb.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, m);  // normal +z
+  scene_data scene = build_scene(std::move(mb.mesh), camera_params{}, sun_params{}, false, 1.0f);
+  bsdf_data b = make_bsdf(scene, eval_surface(scene, 0, 0.25f, 0.25f, {0, 0, -1}));
+  CHECK(b.kd.x == Approx(0.8 / 1.4).epsilon(1e-6));
+  CHECK(b.ks.x == Approx(0.6 / 1.4).epsilon(1e-6));
+  CHECK(albedo_at_normal_incidence(b) == Approx(1.0).epsilon(2e-4));
 }
