@@ -1500,3 +1500,40 @@ TEST_CASE("texture options that are not applied, and textured faces without vt, 
   dir.write("lib.mtl", "newmtl a\nmap_Kd -colorspace linear a.png\n");
   CHECK_THAT(load_warnings(quiet), Catch::Contains("not applied (the texture is used without them): -colorspace (line 2)"));
 }
+
+TEST_CASE("a concave polygon's corners on one line are each a corner of a triangle with area", "[obj]") {
+  // Ear clipping must not cut a corner that lies on the line of its neighbours as a zero-area "ear": the corner would
+  // then belong to no triangle with area, a T-junction on the edge a neighbouring face shares (a crack between the
+  // faces where rounding differs). An L and two Us, with corners in the middle of edges, from every first corner
+  // and in both windings (a mutation of the ear test from > 0 to >= 0 passed every other test).
+  const std::vector<std::vector<vec3f>> shapes = {
+      {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}, {0, 1, 0}},
+      {{0, 0, 0}, {1.5f, 0, 0}, {3, 0, 0}, {3, 2, 0}, {2, 2, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0},
+       {0, 1, 0}},
+      // A deep U: the first corner clipping tries, (0, 0), holds the notch's corner (1, 0.5) in its ear, so clipping
+      // moves on to (0, 1), still on the line of both its neighbours.
+      {{0, 0, 0}, {3, 0, 0}, {3, 2, 0}, {2, 2, 0}, {2, 0.5f, 0}, {1, 0.5f, 0}, {1, 2, 0}, {0, 2, 0}, {0, 1, 0}}};
+  for (size_t s = 0; s < shapes.size(); s++)
+    for (bool reversed : {false, true})
+      for (size_t first = 0; first < shapes[s].size(); first++) {
+        std::vector<vec3f> p;
+        const size_t n = shapes[s].size();
+        for (size_t k = 0; k < n; k++) {
+          size_t i = (first + (reversed ? n - k : k)) % n;
+          p.push_back(shapes[s][i]);
+        }
+        triangulate_state st;
+        std::vector<int> tris;
+        triangulate_polygon(p, st, tris);
+        std::vector<int> used(n, 0);
+        for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+          vec3f a = p[size_t(tris[t])], b = p[size_t(tris[t + 1])], c = p[size_t(tris[t + 2])];
+          if (length(cross(b - a, c - a)) == 0) continue;
+          for (int k = 0; k < 3; k++) used[size_t(tris[t + size_t(k)])]++;
+        }
+        for (size_t k = 0; k < n; k++) {
+          INFO("shape " << s << " reversed " << reversed << " first " << first << " corner " << k);
+          CHECK(used[k] > 0);
+        }
+      }
+}
