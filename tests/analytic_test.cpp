@@ -68,17 +68,20 @@ double under_square_lamp(double a, double h, double le, double rho) {
   return rho / M_PI * 4 * le * s * std::atan(s);
 }
 
-// A Lambertian floor of albedo rho, a square emitter of side 2a and radiance le at height h facing it, and a small
-// quad of radiance other_le high up facing away (it never lights the floor, but the samplers that trust power or
-// bounds still spend draws on it).
-mesh_data square_lamp_mesh(float a, float h, float le, float rho, float other_le) {
+// A Lambertian floor of albedo rho, a square emitter of side 2a and radiance le at height h facing it (or facing
+// up, away from it), and a small quad of radiance other_le high up facing away (it never lights the floor, but the
+// samplers that trust power or bounds still spend draws on it).
+mesh_data square_lamp_mesh(float a, float h, float le, float rho, float other_le, bool facing_floor = true) {
   mesh_builder b;
   int floor = b.add_material({rho, rho, rho});
   int lamp = b.add_material({0, 0, 0}, {le, le, le});
   int other = b.add_material({0, 0, 0}, {other_le, other_le, other_le});
   b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
-  b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);  // normal -y: faces the floor
-  b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, other);     // faces up: never lights the floor
+  if (facing_floor)
+    b.add_quad({-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}, lamp);  // normal -y
+  else
+    b.add_quad({-a, h, -a}, {-a, h, a}, {a, h, a}, {a, h, -a}, lamp);  // normal +y
+  b.add_quad({5, 3, 5}, {5, 3, 6}, {6, 3, 6}, {6, 3, 5}, other);  // faces up: never lights the floor
   return b.mesh;
 }
 
@@ -419,15 +422,12 @@ TEST_CASE("a two-sided lamp lights the floor its back faces, with every sampler"
   // two_sided_emitters: a single sheet emits from both faces. A square lamp facing up, away from the floor, lights it
   // with its back: the light tree's normal cones, the bounds and the samplers' pmfs must all count that side.
   const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
+  // (The small quad emits nothing here: two-sided, it would light the floor too.)
+  const mesh_data mesh = square_lamp_mesh(a, h, le, rho, 0, false);
   for (sampler_kind kind : kinds)
     for (int depth : {1, 2}) {
-      mesh_builder b;
-      int floor = b.add_material({rho, rho, rho});
-      int lamp = b.add_material({0, 0, 0}, {le, le, le});
-      b.add_quad({-20, 0, -20}, {-20, 0, 20}, {20, 0, 20}, {20, 0, -20}, floor);
-      b.add_quad({-a, h, -a}, {-a, h, a}, {a, h, a}, {a, h, -a}, lamp);  // normal +y: faces away from the floor
       INFO("sampler " << sampler_name(kind) << " depth " << depth);
-      check_estimate(render_pixels(b.mesh, looking_down(h / 2), {}, true, kind, depth, 512),
+      check_estimate(render_pixels(mesh, looking_down(h / 2), {}, true, kind, depth, 512),
                      under_square_lamp(a, h, le, rho));
     }
 }
