@@ -510,7 +510,9 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
   if (r.value<uint32_t>() != version) throw input_error(path, "checkpoint of another bayeslight version");
   if (r.value<uint64_t>() != fingerprint)
     throw input_error(path, std::string("checkpoint was written for a different scene or different render options") +
-                                (params.frames > 1 ? " (an animation's also for another --frames, --spp, --time or --frame-decay)" : ""));
+                                (params.frames > 1
+                                     ? " (an animation's also for another --frames, --spp, --time or --frame-decay)"
+                                     : ""));
   const uint64_t reference = r.value<uint64_t>();
   if (r.value<uint32_t>() != uint32_t(sampler.index())) r.fail("sampler kind");
   int w = r.value<int>(), hgt = r.value<int>();
