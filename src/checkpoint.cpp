@@ -149,6 +149,8 @@ void read_regions(reader& r, region_state& s, int nodes, bool sun) {
   s.pair_slot = r.column<int>(size_t(s.pairs));
   s.pending = r.column<region_slot>();
   s.pending_count = size_t(r.value<uint64_t>());
+  // Region 0 is the root, every point's last resort (a render always has it, and it has no parent).
+  if (n == 0 || s.parent[0] != invalid_id) r.fail("region layout");
   for (size_t i = 0; i < n; i++) {
     int c = s.cut_size[i], m = s.pair_count[i];
     if (s.cut_offset[i] < 0 || c < 0 || size_t(s.cut_offset[i]) + size_t(c) > s.cut_nodes.size() ||
@@ -250,7 +252,8 @@ void write_sampler(writer& w, const light_sampler& ls) {
   }
 }
 
-void read_sampler(reader& r, light_sampler& ls) {
+// `pixels`: the image's pixel count (the fallback check's columns are indexed by pixel).
+void read_sampler(reader& r, light_sampler& ls, size_t pixels) {
   if (auto* b = std::get_if<bound_sampler>(&ls))
     read_regions(r, b->regions, node_count(*b->tree), b->lights->sun != invalid_id);
   if (auto* b = std::get_if<bayes_sampler>(&ls)) {
@@ -284,8 +287,9 @@ void read_sampler(reader& r, light_sampler& ls) {
     b->check_done = r.value<uint8_t>() != 0;
     uint64_t checked = r.value<uint64_t>();
     b->px_prev = r.column<float>();
-    if (b->fallback_votes < 0 || b->fallback_spp < 0 || !std::isfinite(b->check_ratio) || checked > (uint64_t(1) << 40) ||
-        !(b->window_samples >= 0) || std::isnan(b->window_var) || std::isnan(b->window_delta) ||
+    if (b->fallback_votes < 0 || b->fallback_spp < 0 || !std::isfinite(b->check_ratio) ||
+        (checked != 0 && checked != pixels) || !(b->window_samples >= 0) || std::isnan(b->window_var) ||
+        std::isnan(b->window_delta) ||
         (!b->px_prev.empty() && b->px_prev.size() != checked))
       r.fail("fallback check");
     b->px_var.assign(size_t(checked), 0.0);
@@ -552,7 +556,7 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
     base_ok = base_ok || result.stratum_base == p.spp;
   }
   if (!passes_ok || spp != result.spp || !base_ok) r.fail("pass state");
-  read_sampler(r, sampler);  // (before the weight: a frozen oracle model does not adapt)
+  read_sampler(r, sampler, size_t(w) * size_t(hgt));  // (before the weight: a frozen oracle model does not adapt)
   // The film's weight is a function of the passes (their spp and the weighting fixed in advance): the same sum, in
   // the same order, as the render's.
   const double weighting = sampler_adapts(sampler) ? params.pass_weighting : 0.0;
@@ -568,8 +572,6 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
   // animation's frame stopped before its first) the film is empty: all zeros.
   for (double x : result.film)
     if (weight > 0 ? !std::isfinite(float(x / weight)) : x != 0) r.fail("film");
-  if (auto* b = std::get_if<bayes_sampler>(&sampler); b && !b->px_var.empty() && b->px_var.size() != result.film.size() / 3)
-    r.fail("fallback check");  // its columns are indexed by pixel
   if (r.pos != body.size()) r.fail("trailing data");
   return reference;
 }

@@ -299,6 +299,7 @@ struct checkpoint_bytes {
 // Offsets of the fields the test edits.
 struct checkpoint_fields {
   size_t passes, film, film_weight, cut_nodes, pair_parent, pending, pending_slots, moments;
+  size_t regions, regions_end;  // the region state: from its first column to the end of its pending table
   uint64_t parents = 0;  // entries of the pair_parent column
 };
 checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
@@ -310,6 +311,7 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   c.value(log * (4 + 4 + 8 + 1 + 3 * 8));
   f.film = c.column(8);
   f.film_weight = c.value(8);
+  f.regions = c.pos;
   for (int k = 0; k < 5; k++) c.column(k == 0 ? 8 : 4);  // key, cut_offset, cut_size, pair_offset, parent
   f.cut_nodes = c.column(4);
   f.parents = c.get<uint64_t>(c.pos);
@@ -319,6 +321,7 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   f.pending_slots = c.get<uint64_t>(c.pos);
   f.pending = c.column(16);                     // {key, id} slots
   c.value(8);                                   // pending count
+  f.regions_end = c.pos;
   if (bayes) f.moments = c.column(8);           // n0
   return f;
 }
@@ -406,6 +409,24 @@ TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed
     edit("film weight infinite", [&](checkpoint_bytes& c) { c.put<double>(f.film_weight, HUGE_VAL); });
     edit("passes", [&](checkpoint_bytes& c) { c.put<int>(f.passes, 2147483647); });
     if (bayes) edit("statistics NaN", [&](checkpoint_bytes& c) { c.put<double>(f.moments, std::nan("")); });
+    // No region at all (every column empty, the counts 0): the render looked up the root region, which every render
+    // has, and crashed.
+    if (!bayes)
+      edit("no regions", [&](checkpoint_bytes& c) {
+        std::string empty(7 * 8 + 8 + 1 + 5 * 8 + 8, '\0');  // 7 columns, pairs, members, 5 columns, pending count
+        c.b = base.b.substr(0, f.regions) + empty + base.b.substr(f.regions_end);
+      });
+    // The fallback check's pixel count (the value before its last column) far beyond the image's, that column
+    // empty: the count was allocated before it was compared with the image, and 2^40 ran out of memory (exit 1).
+    if (bayes)
+      edit("fallback check beyond the image", [&](checkpoint_bytes& c) {
+        const size_t end = c.b.size() - 8, pixels = 32 * 24;  // before the checksum
+        size_t at = end - 8 - 8;                               // an empty last column
+        if (c.get<uint64_t>(end - 8 - 4 * pixels) == pixels) at = end - 8 - 4 * pixels - 8;
+        REQUIRE(c.get<uint64_t>(at) == (at == end - 16 ? 0 : pixels));
+        c.b = c.b.substr(0, at) + std::string(16, '\0') + c.b.substr(end);
+        c.put<uint64_t>(at, uint64_t(1) << 40);
+      });
     // The unedited file, re-sealed the same way, resumes: the edits alone are refused.
     write_text(d / "same.bin", base.sealed());
     auto ok = run_bayeslight(args(sampler) + " --spp 16 --resume " + (d / "same.bin") + " -o " + (d / "ok.exr"));
