@@ -15,6 +15,8 @@
 #include <initializer_list>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <unordered_set>
 #include <vector>
 
 namespace bl {
@@ -202,12 +204,16 @@ void parse_sun(const desc_context& ctx, const json& j, sun_params& sun) {
   sun.irradiance = get_vec3(ctx, j["irradiance"], "irradiance");
   if (sun.irradiance.x < 0 || sun.irradiance.y < 0 || sun.irradiance.z < 0)
     ctx.fail("irradiance", "sun \"irradiance\" must not be negative");
-  if (given(j, "angular_diameter_deg"))
-    sun.angular_diameter_deg = get_number(ctx, j["angular_diameter_deg"], "angular_diameter_deg");
-  // (180: a half-angle of 90 degrees, the whole sky on the sun's side; a wider disk would reach below the horizon of a
-  // surface facing it, which its irradiance could not then describe.)
-  if (!(sun.angular_diameter_deg > 0 && sun.angular_diameter_deg <= 180))
-    ctx.fail("angular_diameter_deg", "sun \"angular_diameter_deg\" must be in (0, 180]");
+  if (given(j, "angular_diameter_deg")) {
+    // Checked in double, then kept above zero in float (1e-50 had become 0 and was refused as outside the interval;
+    // sun_one_minus_cos takes any disk below a micro-radian as one).
+    // (180: a half-angle of 90 degrees, the whole sky on the sun's side; a wider disk would reach below the horizon of
+    // a surface facing it, which its irradiance could not then describe.)
+    double deg = get_double(ctx, j["angular_diameter_deg"], "angular_diameter_deg");
+    if (!(deg > 0 && deg <= 180))
+      ctx.fail("angular_diameter_deg", "sun \"angular_diameter_deg\" must be in (0, 180]");
+    sun.angular_diameter_deg = std::max(float(deg), std::numeric_limits<float>::denorm_min());
+  }
   // The disk's radiance (irradiance over its projected solid angle) must stay far inside float's range.
   double omc = sun_one_minus_cos(sun.angular_diameter_deg);
   double radiance = double(max_component(sun.irradiance)) / (M_PI * omc * (2 - omc));
@@ -242,16 +248,14 @@ scene_desc load_scene_desc(const std::string& path) {
 
   json root;
   // Keys given twice in one object: nlohmann keeps the last silently, which would drop the first's settings.
-  std::vector<std::vector<std::string>> open_objects;
+  std::vector<std::unordered_set<std::string>> open_objects;  // (a set: a file of 10^5 keys took seconds)
   std::string duplicate;
   auto on_event = [&](int, json::parse_event_t event, json& parsed) {
     if (event == json::parse_event_t::object_start) open_objects.emplace_back();
     else if (event == json::parse_event_t::object_end && !open_objects.empty()) open_objects.pop_back();
     else if (event == json::parse_event_t::key && !open_objects.empty() && duplicate.empty()) {
-      std::vector<std::string>& keys = open_objects.back();
       const std::string& k = parsed.get_ref<const std::string&>();
-      if (std::find(keys.begin(), keys.end(), k) != keys.end()) duplicate = k;
-      keys.push_back(k);
+      if (!open_objects.back().insert(k).second) duplicate = k;
     }
     return true;
   };
