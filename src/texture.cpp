@@ -70,7 +70,8 @@ static long long uncompressed_size(const std::string& b, long long w, long long 
   if (b.size() >= 18 && b.compare(0, 2, "BM") != 0) {  // TGA (only .tga files without PNG/JPEG magic get here)
     long long type = (unsigned char)b[2], bytes_pp = ((unsigned char)b[16] + 7) / 8;
     long long palette = b[1] ? le(b, 5, 2) * (((unsigned char)b[7] + 7) / 8) : 0;
-    long long data = 18 + (unsigned char)b[0] + palette;
+    // stb_image skips as many bytes as the colour map's first entry index (le(b, 3, 2)) before the palette.
+    long long data = 18 + (unsigned char)b[0] + (b[1] ? le(b, 3, 2) : 0) + palette;
     if (type >= 1 && type <= 3) return data + w * h * bytes_pp;
     if (type >= 9 && type <= 11) {
       // Packets: a header byte, then one pixel repeated (high bit set) or (header & 127) + 1 raw pixels; each

@@ -290,6 +290,21 @@ TEST_CASE("truncated TGA and BMP files and impossible sizes are input errors", "
     INFO(cut << " bytes");
     CHECK_THAT(texture_error(dir.file("rle_cut.tga")), Catch::Contains("rle_cut.tga: cannot decode image: truncated"));
   }
+  // Colour-mapped 4x4 (type 1): 16 bytes skipped before a palette of two 24-bit entries (the colour map's first
+  // index), then 16 index bytes. The guard left out those 16 bytes: cut by 14, it decoded the missing indices as 0.
+  std::string mapped("\0\x01\x01\x10\0\x02\0\x18\0\0\0\0\x04\0\x04\0\x08\x20", 18);
+  mapped += std::string(16, '\0') + std::string("\0\0\xff\0\xff\0", 6) + std::string(16, '\x01');
+  write_bytes(dir.file("mapped.tga"), mapped);
+  texture_data m = load_texture(dir.file("mapped.tga"));
+  REQUIRE(m.width == 4);
+  CHECK(texel_rgb(m, 15).y == srgb8_to_linear(0xff));  // index 1: green
+  CHECK(texel_rgb(m, 15).x == 0);
+  for (size_t cut : {size_t(55), size_t(42), size_t(35)}) {
+    write_bytes(dir.file("mapped_cut.tga"), mapped.substr(0, cut));
+    INFO(cut << " bytes");
+    CHECK_THAT(texture_error(dir.file("mapped_cut.tga")),
+               Catch::Contains("mapped_cut.tga: cannot decode image: truncated"));
+  }
   // A BMP written by stb, whole and cut short.
   std::vector<unsigned char> px(8 * 8 * 3, 77);
   REQUIRE(stbi_write_bmp(dir.file("ok.bmp").c_str(), 8, 8, 3, px.data()) != 0);
