@@ -109,7 +109,10 @@ void check_output_path(const std::string& path) {
   // /dev/null), which is written in place, so that its directory need not be writable.
   std::error_code ec;
   const fs::file_status st = fs::status(p, ec);
-  if (ec == std::errc::too_many_symbolic_link_levels) throw output_error("cannot write " + path + ": " + ec.message());
+  // Any failure but a missing file or folder (said below) ends here: a loop, a name too long, a folder that may not be
+  // searched (they were found only when the output was written, after the render).
+  if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
+    throw output_error("cannot write " + path + ": " + ec.message());
   if (!ec && fs::is_directory(st)) throw output_error("cannot write " + path + ": is a directory");
   if (!ec && fs::exists(st) && !fs::is_regular_file(st)) return;
   if (fs::is_symlink(fs::symlink_status(p, ec))) {

@@ -1225,6 +1225,19 @@ TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
   auto r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "no/such/dir/out.exr"));
   CHECK(r.status == 1);
   CHECK(r.output.find("no/such/dir") != std::string::npos);
+  // A name longer than a folder entry may be (an image, a log or a checkpoint): found when it was written, after the
+  // render, which wrote the other outputs (here the log) meanwhile.
+  const std::string long_name = std::string(300, 'a');
+  for (const std::string& bad : {"-o " + (s.dir / (long_name + ".exr")), "--log " + (s.dir / (long_name + ".csv")),
+                                 "--checkpoint " + (s.dir / (long_name + ".ck"))}) {
+    const std::string other = bad.rfind("--log", 0) == 0 ? " -o " + (s.dir / "ok.pfm") : " --log " + (s.dir / "ok.csv");
+    r = run_bayeslight("render " + s.json + " --quiet --spp 1 --width 8 --height 6 " + bad + other);
+    INFO(bad.substr(0, 12) << "\n" << r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find("File name too long") != std::string::npos);
+    CHECK(!std::filesystem::exists(s.dir / "ok.pfm"));
+    CHECK(!std::filesystem::exists(s.dir / "ok.csv"));
+  }
 }
 
 TEST_CASE("a bare OBJ renders with the default framing", "[cli]") {
