@@ -23,7 +23,7 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // reference's hash; 13: the region options as resolved in the fingerprint, Kd 0 for a library material without one;
 // 14: hits on huge triangles take the ray's point, a thin scene's cells its own shortest extent; 15: map_d's -imfchan
 // and an RGB mask's luminance, cells of at least 4 ulps
-constexpr uint32_t version = 15;
+constexpr uint32_t version = 16;  // 16: the fingerprint's parts
 
 }  // namespace
 
@@ -52,6 +52,31 @@ struct hasher {
   template <class T>
   void column(const std::vector<T>& v) {
     bytes(v.data(), v.size() * sizeof(T));
+  }
+};
+
+// Hashes the fingerprint as one sequence (the total) and each part alone: values go to both.
+struct part_hasher {
+  hasher total, part;
+  render_fingerprint_data* out;
+  int current = -1;
+  void begin(int p) {
+    finish();
+    current = p, part = hasher{};
+  }
+  void finish() {
+    if (current >= 0) out->parts[current] = part.h;
+    current = -1;
+  }
+  void bytes(const void* data, size_t n) { total.bytes(data, n), part.bytes(data, n); }
+  template <class T>
+  void value(const T& v) {
+    total.value(v), part.value(v);
+  }
+  void vec(vec3f v) { total.vec(v), part.vec(v); }
+  template <class T>
+  void column(const std::vector<T>& v) {
+    total.column(v), part.column(v);
   }
 };
 
@@ -319,8 +344,27 @@ void read_sampler(reader& r, light_sampler& ls, size_t pixels) {
 
 }  // namespace
 
-uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
-  hasher h;
+const char* fingerprint_part_name(int part) {
+  switch (part) {
+    case fp_scene: return "the scene (its mesh, materials, textures, camera, sun or two_sided_emitters)";
+    case fp_image_size: return "the image size";
+    case fp_max_depth: return "--max-depth";
+    case fp_seed: return "the seed";
+    case fp_sampler: return "the sampler";
+    case fp_light_samples: return "the light samples (--independent-samples, --light-samples)";
+    case fp_animation: return "the animation (--frames, the sun's direction_end, --frame-decay, --spp or --time)";
+    case fp_pass_weighting: return "--pass-weighting";
+    case fp_regions: return "the region options (--grid, --max-cut, --cut-*, --region-*, --shared-cut-lights)";
+    case fp_bayes: return "the bayes options (--bayes-*)";
+    case fp_donikian: return "the donikian options";
+    default: return "?";
+  }
+}
+
+render_fingerprint_data render_fingerprint(const scene_data& scene, const render_params& p) {
+  render_fingerprint_data f;
+  part_hasher h{{}, {}, &f};
+  h.begin(fp_scene);
   const mesh_data& m = scene.mesh;
   h.column(m.positions);
   h.column(m.normals);
@@ -345,10 +389,19 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   h.vec(scene.camera.eye), h.vec(scene.camera.target), h.vec(scene.camera.up), h.value(scene.camera.fov_y_deg);
   h.value(scene.sun.enabled), h.vec(scene.sun.direction), h.vec(scene.sun.irradiance);
   h.value(scene.sun.angular_diameter_deg), h.value(scene.two_sided_emitters);
-  h.value(p.width), h.value(p.height), h.value(p.max_depth), h.value(p.seed), h.value(int(p.sampler.kind));
+  h.begin(fp_image_size);
+  h.value(p.width), h.value(p.height);
+  h.begin(fp_max_depth);
+  h.value(p.max_depth);
+  h.begin(fp_seed);
+  h.value(p.seed);
+  h.begin(fp_sampler);
+  h.value(int(p.sampler.kind));
+  h.begin(fp_light_samples);
   h.value(p.stratify);
   if (p.light_samples != 1) h.value(p.light_samples);  // (one: the fingerprint of checkpoints from before the option)
   const sampler_kind k = p.sampler.kind;
+  h.begin(fp_animation);
   if (p.frames > 1) {
     // An animation: its frame count and the sun's end (each frame's sun), and, for a learning sampler, how much of
     // its statistics a frame keeps. (A still's fingerprint is what it was before animations could be resumed.)
@@ -365,7 +418,9 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
   // Nor the options the others leave without effect (as the command line's warning names them: a resume with
   // --pass-weighting 8 of a --bayes-oracle render was refused right after the warning said it was ignored; a review).
   const bool frozen = k == sampler_kind::bayes && p.sampler.bayes.oracle_spp > 0;
+  h.begin(fp_pass_weighting);
   if ((k == sampler_kind::donikian || k == sampler_kind::bayes) && !frozen) h.value(p.pass_weighting);  // adaptive
+  h.begin(fp_regions);
   if (regions) {
     // As the render resolves them: a default given explicitly (--cut-members 128 in direct illumination, the automatic
     // pair budget) renders the same image and was refused as a different render. donikian's first hit reads only
@@ -377,6 +432,7 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
       h.value(r.max_members);
     }
   }
+  h.begin(fp_bayes);
   if (k == sampler_kind::bayes) {
     bayes_params b = p.sampler.bayes;
     const bayes_params d;
@@ -391,11 +447,14 @@ uint64_t render_fingerprint(const scene_data& scene, const render_params& p) {
     h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
     h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
   }
+  h.begin(fp_donikian);
   if (k == sampler_kind::donikian) {
     const donikian_params& d = p.sampler.donikian;
     h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
   }
-  return h.h;
+  h.finish();
+  f.total = h.total.h;
+  return f;
 }
 
 namespace {
@@ -465,11 +524,13 @@ uint64_t reference_hash(const image_data* reference) {
 }
 
 // Every field of a checkpoint but the checksum that ends it.
-static void emit_checkpoint(writer& w, uint64_t fingerprint, uint64_t reference, const render_result& result,
-                            const light_sampler& sampler, int frames) {
+static void emit_checkpoint(writer& w, const render_fingerprint_data& fingerprint, uint64_t reference,
+                            const render_result& result, const light_sampler& sampler, int frames) {
   w.bytes(magic, sizeof magic);
   w.value(version);
-  w.value(fingerprint);
+  w.value(fingerprint.total);
+  w.value(uint32_t(fp_part_count));
+  for (uint64_t part : fingerprint.parts) w.value(part);
   w.value(reference);
   w.value(uint32_t(sampler.index()));
   w.value(result.width), w.value(result.height);
@@ -487,8 +548,8 @@ static void emit_checkpoint(writer& w, uint64_t fingerprint, uint64_t reference,
   write_sampler(w, sampler);
 }
 
-void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,
-                      const light_sampler& sampler, int frames) {
+void write_checkpoint(const std::string& path, const render_fingerprint_data& fingerprint, uint64_t reference,
+                      const render_result& result, const light_sampler& sampler, int frames) {
   write_file_atomic_stream(path, [&](const byte_sink& sink) {
     streaming_checksum sum;
     writer w;
@@ -501,8 +562,9 @@ void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t re
   });
 }
 
-uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
-                           const render_params& params, render_result& result, light_sampler& sampler) {
+uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
+                           const render_fingerprint_data& fingerprint, const render_params& params,
+                           render_result& result, light_sampler& sampler) {
   if (bytes.size() < sizeof magic + 8 || std::memcmp(bytes.data(), magic, sizeof magic) != 0)
     throw input_error(path, "not a bayeslight checkpoint");
   uint64_t stored;
@@ -512,14 +574,28 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, ui
   const std::string_view body = std::string_view(bytes).substr(0, bytes.size() - 8);
   reader r{body, path, sizeof magic};
   if (r.value<uint32_t>() != version) throw input_error(path, "checkpoint of another bayeslight version");
-  if (r.value<uint64_t>() != fingerprint)
-    throw input_error(path, std::string("checkpoint was written for a different scene or different render options") +
-                                (params.frames > 1
-                                     ? " (an animation's also for another --frames, --spp, --time or --frame-decay)"
-                                     : ""));
+  const uint64_t total = r.value<uint64_t>();
+  if (r.value<uint32_t>() != fp_part_count) r.fail("fingerprint");
+  render_fingerprint_data saved;
+  for (uint64_t& part : saved.parts) part = r.value<uint64_t>();
   const uint64_t reference = r.value<uint64_t>();
-  if (r.value<uint32_t>() != uint32_t(sampler.index())) r.fail("sampler kind");
+  const uint32_t kind = r.value<uint32_t>();
   int w = r.value<int>(), hgt = r.value<int>();
+  if (total != fingerprint.total) {
+    // Name what differs (the parts whose hashes differ; the image size as saved, the likeliest slip).
+    std::string which;
+    int count = 0;
+    // (Another sampler brings its own options: they are not named too.)
+    const bool sampler = saved.parts[fp_sampler] != fingerprint.parts[fp_sampler];
+    for (int p = 0; p < fp_part_count; p++)
+      if (saved.parts[p] != fingerprint.parts[p] && !(sampler && p >= fp_pass_weighting)) {
+        which += std::string(count++ ? ", " : "") + fingerprint_part_name(p);
+        if (p == fp_image_size) which += " (" + std::to_string(w) + "x" + std::to_string(hgt) + " there)";
+      }
+    throw input_error(path, "checkpoint was written for a different scene or different render options" +
+                                (count > 0 ? ": " + which + (count > 1 ? " differ" : " differs") : std::string()));
+  }
+  if (kind != uint32_t(sampler.index())) r.fail("sampler kind");
   if (w != result.width || hgt != result.height) r.fail("image size");
   result.frame = params.frames > 1 ? r.value<int>() : 0;
   if (result.frame < 0 || result.frame >= std::max(1, params.frames)) r.fail("frame");

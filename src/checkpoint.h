@@ -17,8 +17,19 @@ namespace bl {
 
 // Fingerprint of what a resumed render must share with the one that wrote the checkpoint: the loaded scene
 // (geometry, materials, textures, camera, sun) and the options that affect pixels (size, depth, seed, sampler
-// and its parameters). The spp target and time budget are not part of it: a render may be resumed further.
-uint64_t render_fingerprint(const scene_data& scene, const render_params& params);
+// and its parameters). The spp target and time budget are not part of it (but for an animation's): a render may be
+// resumed further. With the hash of each part, so that a refused resume names the parts that differ.
+enum fingerprint_part : int {  // (from fp_pass_weighting on: options of the sampler in use)
+  fp_scene, fp_image_size, fp_max_depth, fp_seed, fp_sampler, fp_light_samples, fp_animation, fp_pass_weighting,
+  fp_regions, fp_bayes, fp_donikian, fp_part_count
+};
+struct render_fingerprint_data {
+  uint64_t total = 0;                  // of everything, in order (what a checkpoint must match)
+  uint64_t parts[fp_part_count] = {};  // of each part alone (0: a part with nothing in it)
+};
+render_fingerprint_data render_fingerprint(const scene_data& scene, const render_params& params);
+// What part `part` covers, as a refusal names it.
+const char* fingerprint_part_name(int part);
 
 // The version of the checkpoint layout: a checkpoint of another one is refused (bayeslight --version says it).
 uint32_t checkpoint_format_version();
@@ -34,13 +45,14 @@ uint64_t reference_hash(const image_data* reference);
 // and the hash of the reference the log's errors were measured against, then a checksum. In pieces, never the whole
 // in memory (each write added its size to the process's memory, 100-200 MB in the living room; a review).
 // `frames`: the render's (render_params::frames); an animation's checkpoint also holds result.frame.
-void write_checkpoint(const std::string& path, uint64_t fingerprint, uint64_t reference, const render_result& result,
-                      const light_sampler& sampler, int frames);
+void write_checkpoint(const std::string& path, const render_fingerprint_data& fingerprint, uint64_t reference,
+                      const render_result& result, const light_sampler& sampler, int frames);
 // Restores a state written by write_checkpoint into a freshly built sampler of the same kind and the result;
-// throws input_error naming `path` when the data are malformed or were written for another scene/options.
+// throws input_error naming `path` when the data are malformed or were written for another scene/options (naming
+// the fingerprint's parts that differ).
 // `params`: the render's, against whose pass weighting the film's weight is checked and whose frame count bounds
 // an animation's frame. Returns the stored reference hash.
-uint64_t decode_checkpoint(const std::string& bytes, const std::string& path, uint64_t fingerprint,
-                           const render_params& params, render_result& result, light_sampler& sampler);
+uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
+                           const render_fingerprint_data& fingerprint, const render_params& params, render_result& result, light_sampler& sampler);
 
 }  // namespace bl

@@ -410,7 +410,7 @@ int run_render(const render_options& o) {
                  std::chrono::duration<double>(t_end - t_bvh).count());
   }
 
-  uint64_t fingerprint = render_fingerprint(scene, params);
+  const render_fingerprint_data fingerprint = render_fingerprint(scene, params);
   // Per frame: the hash of the reference a frame's logged errors are measured against (0: none).
   std::vector<uint64_t> reference_keys;
   for (int f = 0; f < params.frames; f++)
@@ -445,6 +445,19 @@ int run_render(const render_options& o) {
                                      " missing (a frame cannot be rendered alone: render the animation again for it)")
                                         .c_str());
       }
+      // A still render (or an animation's first frame) says what it continues, and what --time leaves of its budget:
+      // the budget is the render's total, the checkpoint's seconds included.
+      const bool budget_spent = params.time_budget > 0 && r.seconds >= params.time_budget;
+      if (r.frame == 0 && !o.quiet) {
+        char budget[160] = "";
+        if (budget_spent)
+          std::snprintf(budget, sizeof budget, "; --time %g counts them and is spent: no pass is added", params.time_budget);
+        else if (params.time_budget > 0)
+          std::snprintf(budget, sizeof budget, "; --time %g counts them: %.2f s left", params.time_budget,
+                        params.time_budget - r.seconds);
+        std::fprintf(stderr, "%s: resuming at %d spp (%d pass%s, %.2f s rendered before)%s\n", o.resume.c_str(), r.spp,
+                     r.passes, r.passes == 1 ? "" : "es", r.seconds, budget);
+      }
       // The log is one error curve against one reference: rows measured against another one (or none) keep their
       // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
       if (measured != reference_key && !r.log.empty()) {
@@ -466,7 +479,7 @@ int run_render(const render_options& o) {
           off = p.spp;
           break;
         }
-      if (sampler_adapts(s) && off > 0 && (params.time_budget > 0 || params.spp > r.spp))
+      if (sampler_adapts(s) && off > 0 && (params.time_budget > 0 ? !budget_spent : params.spp > r.spp))
         std::fprintf(stderr,
                      "%s: warning: its pass ending at %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 "
                      "... do): the continued image is correct, but not bit-identical to one render of the final spp\n",
@@ -514,6 +527,7 @@ int run_render(const render_options& o) {
   output_failures failures;  // every output is tried (and every frame rendered) whatever failed before it
   failures.say_now = params.frames > 1;
   int last_frame = -1;  // the last frame whose outputs were written
+  int last_passes = 0;  // ... and its passes (none: a checkpoint there is an earlier render's)
   render_frames(scene, bvh, lights, params, [&](int frame, const render_result& result) {
     earlier_passes += result.passes;
     last_frame = frame;
@@ -541,6 +555,7 @@ int run_render(const render_options& o) {
       std::fprintf(stderr, "%s%s\n", prefix.c_str(), render_summary(result, files).c_str());
     }
     interrupted = result.interrupted;
+    last_passes = result.passes;
   });
   failures.rethrow();  // (main exits 128 + signal when a signal came, else 1)
   // A signal that came after the last pass (while the outputs were written) still ends the run as interrupted.
@@ -558,6 +573,9 @@ int run_render(const render_options& o) {
     else if (!interrupted)
       std::fprintf(stderr, "bayeslight: interrupted (%s) after the last pass; every output was written\n",
                    signal_name(sig));
+    else if (!o.checkpoint.empty() && checkpoint_failure.empty() && last_passes > 0)  // (a still render)
+      std::fprintf(stderr, "bayeslight: %s holds the render; --resume %s continues it\n", o.checkpoint.c_str(),
+                   o.checkpoint.c_str());
     return 128 + (sig != 0 ? sig : SIGINT);
   }
   if (!checkpoint_failure.empty()) throw output_error(checkpoint_failure);  // (the image is written)
@@ -741,7 +759,8 @@ void add_render_command(CLI::App& app, render_options& o) {
       ->check(CLI::Range(0.0, 1e9))->check(finite_number);
   r->add_option("--resume", o.resume,
                 "Continue the render saved in FILE (same scene and options; --spp may be larger: the same bytes as one render "
-                "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...)")
+                "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...); its spp, "
+                "seconds and --time budget count the saved ones")
       ->check(file_name);
   r->add_flag("--signal-after-last-pass", o.signal_after_last_pass,
               "testing: raise SIGINT once the last pass is done, before the outputs are written")

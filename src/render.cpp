@@ -481,6 +481,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     if (!params.frame_references.empty()) fp.reference = params.frame_references[size_t(frame)];
     if (frame > 0) set_sun_direction(lights, animated_sun_direction(scene.sun, frame, frames));
     if (frame > first) std::visit([&](auto& s) { s.begin_frame(params.frame_decay); }, sampler);
+    if (auto* b = std::get_if<bayes_sampler>(&sampler); b && frame > first) result.fallback_earlier = b->fallback;
     std::function<void()> after_pass;
     if (params.on_pass) after_pass = [&] { params.on_pass(result, sampler, false); };
     // Each frame has its own random streams (frame 0 the render's seed): with the same streams in every frame, a

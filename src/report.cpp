@@ -53,14 +53,17 @@ std::string render_summary(const render_result& r, const std::vector<std::string
   if (r.regions > 0) {
     // One region: a cut shared by all (a handful of lights), which the bound sampler reads from the root alone.
     if (r.regions == 1)
-      std::snprintf(buf, sizeof buf, "; 1 region, %.0f clusters, %.1f MB sampler state", double(r.pairs),
+      std::snprintf(buf, sizeof buf, "; 1 region, %.0f clusters or members, %.1f MB sampler state", double(r.pairs),
                     double(r.sampler_bytes) / (1 << 20));
     else
-      std::snprintf(buf, sizeof buf, "; %d regions, %.1f clusters per region, %.1f MB sampler state", r.regions,
+      std::snprintf(buf, sizeof buf, "; %d regions, %.1f clusters or members per region, %.1f MB sampler state", r.regions,
                     double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));
     s += buf;
   }
-  if (r.fallback_spp > 0) {
+  if (r.fallback_spp > 0 && r.fallback_earlier) {
+    std::snprintf(buf, sizeof buf, "; power sampling since an earlier frame (after %d spp of it)", r.fallback_spp);
+    s += buf;
+  } else if (r.fallback_spp > 0) {
     std::snprintf(buf, sizeof buf, "; power sampling after %d spp (learning was estimated to cut relMSE per sample only %.2fx)",
                   r.fallback_spp, r.fallback_ratio);
     s += buf;

@@ -351,20 +351,21 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
   CHECK(run_bayeslight(base + " --frames 4 --resume " + ck).status == 3);
   auto decay = run_bayeslight(args + " --frame-decay 0.7 --resume " + ck);
   CHECK(decay.status == 3);
-  CHECK(decay.output.find("--frame-decay)") != std::string::npos);  // (the message named every option but this one)
+  CHECK(decay.output.find(": the animation (--frames, the sun's direction_end, --frame-decay, --spp or --time) differs") !=
+        std::string::npos);  // (the message named every option but --frame-decay)
   // Nor with other samples per frame: frame 0 was rendered with 27 spp and frame 1 learned from it.
   auto more = run_bayeslight("render " + anim + " --spp 40 --frames 3 --quiet -o " + (a.dir / "part_%d.pfm") +
                              " --resume " + ck);
   CHECK(more.status == 3);
-  CHECK(more.output.find("(an animation's also for another --frames, --spp, --time or --frame-decay)") !=
+  CHECK(more.output.find(": the animation (--frames, the sun's direction_end, --frame-decay, --spp or --time) differs") !=
         std::string::npos);
   CHECK(run_bayeslight("render " + anim + " --spp 27 --quiet -o " + (a.dir / "still.pfm") + " --resume " + ck).status == 3);
-  // The frame index (after magic, version, fingerprint, reference hash, sampler kind, width and height) edited out of
-  // range and the file re-sealed with its checksum: refused, never followed.
+  // The frame index (after magic, version, fingerprint and its parts, reference hash, sampler kind, width and
+  // height) edited out of range and the file re-sealed with its checksum: refused, never followed.
   const std::string saved = read_file(ck);
   for (int bad : {-1, 3, 1 << 30}) {
     std::string body = saved.substr(0, saved.size() - 8);
-    std::memcpy(&body[16 + 4 + 8 + 8 + 4 + 4 + 4], &bad, sizeof bad);
+    std::memcpy(&body[16 + 4 + 8 + 4 + 8 * fp_part_count + 8 + 4 + 4 + 4], &bad, sizeof bad);
     uint64_t h = checkpoint_checksum(body);
     write_text(a.dir / "edited.bin", body + std::string(reinterpret_cast<const char*>(&h), 8));
     auto e = run_bayeslight(args + " --resume " + (a.dir / "edited.bin"));

@@ -47,6 +47,7 @@ TEST_CASE("interrupted and killed renders resume to the same bytes", "[checkpoin
     auto r1 = run_bayeslight(base_args(s) + " -o " + part + " --checkpoint " + ck + " --stop-after-passes 9");
     CHECK(r1.status == 130);
     REQUIRE(std::filesystem::exists(ck));
+    CHECK(r1.output.find(ck + " holds the render; --resume " + ck + " continues it") != std::string::npos);
     auto r2 = run_bayeslight(base_args(s) + " -o " + out + " --resume " + ck);
     INFO(r2.output);
     REQUIRE(r2.status == 0);
@@ -60,6 +61,30 @@ TEST_CASE("interrupted and killed renders resume to the same bytes", "[checkpoin
     REQUIRE(run_bayeslight(base_args(s) + " -o " + out2 + " --resume " + ck2).status == 0);
     CHECK(read_file(out2) == read_file(full));
   }
+}
+
+TEST_CASE("a resumed render says what it continues and what --time leaves", "[checkpoint]") {
+  // The summary's spp and seconds are the render's totals, the checkpoint's included, and so is a --time budget: a
+  // budget the checkpoint had spent rewrote its image without a word (and warned that the passes added, none, were
+  // off schedule).
+  temp_dir d;
+  const std::string args = cornell_args("bayes", 32, 24), ck = d / "ck.bin";
+  REQUIRE(run_bayeslight(args + " --spp 20 --checkpoint " + ck + " -o " + (d / "a.pfm")).status == 0);
+  const std::string loud = args.substr(0, args.size() - std::string(" --quiet").size());
+  auto more = run_bayeslight(loud + " --spp 40 --resume " + ck + " -o " + (d / "b.pfm"));
+  INFO(more.output);
+  REQUIRE(more.status == 0);
+  CHECK(more.output.find(ck + ": resuming at 20 spp (") != std::string::npos);
+  CHECK(more.output.find("rendered 40 spp") != std::string::npos);
+  auto spent = run_bayeslight(loud + " --time 0.000001 --resume " + ck + " -o " + (d / "c.pfm"));
+  INFO(spent.output);
+  REQUIRE(spent.status == 0);
+  CHECK(spent.output.find("--time 1e-06 counts them and is spent: no pass is added") != std::string::npos);
+  CHECK(spent.output.find("not bit-identical") == std::string::npos);
+  CHECK(spent.output.find("rendered 20 spp") != std::string::npos);
+  CHECK(read_file(d / "c.pfm") == read_file(d / "a.pfm"));
+  auto quiet = run_bayeslight(args + " --spp 40 --resume " + ck + " -o " + (d / "b.pfm"));
+  CHECK(quiet.output.find("resuming") == std::string::npos);
 }
 
 TEST_CASE("a checkpoint written in pieces resumes to the same bytes", "[checkpoint]") {
@@ -203,15 +228,30 @@ TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[ch
   temp_dir d;
   std::string ck = d / "ck.bin";
   REQUIRE(run_bayeslight(base_args("bayes") + " -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
-  for (const std::string& other : {base_args("bayes") + " --seed 5", base_args("bayes") + " --max-depth 2",
-                                   base_args("bound"), base_args("bayes") + " --bayes-b0 2",
-                                   base_args("bayes") + " --light-samples 2",
-                                   "render " + source_path("data/cornell/path.json") +
-                                       " --sampler bayes --width 40 --height 30 --spp 30 --quiet"}) {
-    auto r = run_bayeslight(other + " -o " + (d / "x.pfm") + " --resume " + ck);
-    INFO(other << "\n" << r.output);
+  // Each refusal names what differs (it had said only "a different scene or different render options", whatever the
+  // slip: a forgotten --width, another seed).
+  const std::string size_args = "render " + source_path("data/living_room/path.json") + " --sampler bayes --spp 27 --quiet";
+  struct other_render {
+    std::string args, differs;
+  };
+  for (const other_render& other :
+       {other_render{base_args("bayes") + " --seed 5", ": the seed differs"},
+        other_render{base_args("bayes") + " --max-depth 2", ": --max-depth differs"},
+        other_render{base_args("bound"), ": the sampler differs"},
+        other_render{base_args("bound") + " --seed 5", ": the seed, the sampler differ"},
+        other_render{base_args("bayes") + " --bayes-b0 2", ": the bayes options (--bayes-*) differs"},
+        other_render{base_args("bayes") + " --light-samples 2",
+                     ": the light samples (--independent-samples, --light-samples) differs"},
+        other_render{base_args("bayes") + " --grid 16", ": the region options ("},
+        other_render{size_args, ": the image size (40x30 there)"},
+        other_render{"render " + source_path("data/cornell/path.json") +
+                         " --sampler bayes --width 40 --height 30 --spp 30 --quiet",
+                     ": the scene (its mesh, materials, textures, camera, sun or two_sided_emitters)"}}) {
+    auto r = run_bayeslight(other.args + " -o " + (d / "x.pfm") + " --resume " + ck);
+    INFO(other.args << "\n" << r.output);
     CHECK(r.status == 3);
-    CHECK(r.output.find("ck.bin") != std::string::npos);
+    CHECK(r.output.find("ck.bin: checkpoint was written for a different scene or different render options" +
+                        other.differs) != std::string::npos);
     CHECK(!std::filesystem::exists(d / "x.pfm"));
   }
   // A flipped byte, a truncated file, a file that is not a checkpoint.
@@ -304,7 +344,8 @@ struct checkpoint_fields {
 };
 checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   checkpoint_fields f{};
-  c.pos = 16 + 4 + 8 + 8 + 4 + 4 + 4;  // magic, version, fingerprint, reference hash, sampler kind, width, height
+  // magic, version, fingerprint (total, part count, parts), reference hash, sampler kind, width, height
+  c.pos = 16 + 4 + 8 + 4 + 8 * fp_part_count + 8 + 4 + 4 + 4;
   f.passes = c.value(4);
   c.value(4 + 4 + 8 + 6 * 8);  // spp, stratum base, seconds, counters
   uint64_t log = c.get<uint64_t>(c.value(8));
@@ -362,7 +403,7 @@ TEST_CASE("the checkpoint fingerprint sees every texture option of every materia
   scene_data scene = build_scene(boxed_lamp_mesh(), cam, sun_params{}, false, 1.0f);
   REQUIRE(!scene.mesh.materials.empty());
   render_params p;
-  const uint64_t base = render_fingerprint(scene, p);
+  const uint64_t base = render_fingerprint(scene, p).total;
   for (int map = 0; map < 2; map++)
     for (int field = 0; field < 5; field++) {
       scene_data changed = scene;
@@ -371,7 +412,8 @@ TEST_CASE("the checkpoint fingerprint sees every texture option of every materia
       if (field < 4) *v[field] += 0.5f;
       else t.clamp = true;
       INFO("map " << map << ", field " << field);
-      CHECK(render_fingerprint(changed, p) != base);
+      CHECK(render_fingerprint(changed, p).total != base);
+      CHECK(render_fingerprint(changed, p).parts[fp_scene] != render_fingerprint(scene, p).parts[fp_scene]);
     }
 }
 

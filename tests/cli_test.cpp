@@ -1387,6 +1387,20 @@ TEST_CASE("profile with --time times the same samples twice and reports their st
   CHECK(r.output.find("nan") == std::string::npos);
 }
 
+TEST_CASE("a profile of bayes says where it fell back to power sampling", "[cli]") {
+  // The stages of its later passes are power sampling's (no region lookup, no learning): the profile had named only
+  // bayes. The path-traced Cornell box at 320 x 240 falls back after 12 spp (fallback_test).
+  auto r = run_bayeslight("profile " + source_path("data/cornell/path.json") + " --width 320 --height 240 --spp 15");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("bayes fell back to power sampling after 12 spp") != std::string::npos);
+  CHECK(r.output.find("the stages below mix 12 spp of bayes with 3 of power sampling") != std::string::npos);
+  auto bound = run_bayeslight("profile " + source_path("data/cornell/path.json") +
+                              " --width 320 --height 240 --spp 15 --sampler bound");
+  REQUIRE(bound.status == 0);
+  CHECK(bound.output.find("fell back") == std::string::npos);
+}
+
 TEST_CASE("a profile of a scene without NEE samples gives its stages per camera ray", "[cli]") {
   // With no emitter every stage was divided by a NEE count of 0 (taken as 1) and printed as ns per NEE sample.
   temp_dir dir;

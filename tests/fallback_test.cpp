@@ -244,6 +244,15 @@ TEST_CASE("bayes falls back where learning cannot pay and not where it does", "[
     CHECK(r.output.find("power sampling after") == std::string::npos);
     CHECK(r.output.find("learning estimated to cut relMSE per sample") != std::string::npos);
   }
+  // An animation keeps the fallback: a later frame says it came in an earlier one (it read as if that frame had fallen
+  // back after 12 of its own spp, even where it was interrupted before).
+  auto frames = run_bayeslight("render " + source_path("data/cornell/path.json") +
+                                " --width 320 --height 240 --spp 15 --frames 2 -o " + (d / "frame_%d.pfm"));
+  INFO(frames.output);
+  REQUIRE(frames.status == 0);
+  CHECK(frames.output.find("frame 0: rendered") != std::string::npos);
+  CHECK(frames.output.find("power sampling after 12 spp") < frames.output.find("frame 1: rendered"));
+  CHECK(frames.output.find("power sampling since an earlier frame (after 12 spp of it)") != std::string::npos);
   // The ablation switch.
   auto off = run("cornell/path", "--bayes-fallback-ratio 0");
   REQUIRE(off.status == 0);
