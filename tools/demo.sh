@@ -26,6 +26,8 @@ echo "error against time (relMSE vs the reference; full per-pass curves in $out/
 for s in bayes bound; do
   tail -n 1 "$out/living_room_$s.csv" | awk -F, '{printf "  %-6s %5d spp in %6.2f s  relMSE %.5g\n", $1, $3, $4, $5}'
 done
-b=$(tail -n 1 "$out/living_room_bayes.csv" | cut -d, -f5); n=$(tail -n 1 "$out/living_room_bound.csv" | cut -d, -f5)
-awk -v b="$b" -v n="$n" 'BEGIN { printf "  bayes speed-up over bound at equal time: %.1fx\n", n / b }'
+# Each render ends with the pass under way at T: the errors are compared at exactly T (interpolated between passes).
+read -r b _ < <(awk -F, -v T="$T" -f tools/at_time.awk "$out/living_room_bayes.csv")
+read -r n _ < <(awk -F, -v T="$T" -f tools/at_time.awk "$out/living_room_bound.csv")
+awk -v b="$b" -v n="$n" -v T="$T" 'BEGIN { printf "  bayes speed-up over bound at equal time (relMSE at %g s): %.1fx\n", T, n / b }'
 echo "images: $out/living_room_bayes.png (.exr), $out/living_room_bound.png (.exr)"

@@ -47,15 +47,7 @@ for scene in $SCENES; do
       # shellcheck disable=SC2086  # OPTS: words on purpose
       "$bin" render "$json" --sampler "$s" --time "$T" --width "$W" --height "$H" --reference "$ref" \
         --log "$tmp/$s.csv" -o "$tmp/$s.exr" --quiet ${OPTS:-}
-      # A --time render finishes the pass under way at T (up to 64 spp more): the error and spp at exactly T are
-      # interpolated between the last pass before T and the first at or after it (log-log for the error).
-      read -r e n < <(awk -F, -v T="$T" '$1 != "sampler" {
-          if ($4 + 0 < T + 0) { t1 = $4; e1 = $5; s1 = $3; next }
-          if (!done) { t2 = $4; e2 = $5; s2 = $3; done = 1 } }
-        END {
-          if (!done || t1 <= 0) { printf "%s %s\n", (done ? e2 : e1), (done ? s2 : s1); exit }
-          f = (log(T) - log(t1)) / (log(t2) - log(t1));
-          printf "%.6g %d\n", exp(log(e1) + f * (log(e2) - log(e1))), s1 + (T - t1) / (t2 - t1) * (s2 - s1) + 0.5 }' "$tmp/$s.csv")
+      read -r e n < <(awk -F, -v T="$T" -f tools/at_time.awk "$tmp/$s.csv")
       err[$s]=$e
       row="$row $(printf '%.4g' "$e") ($n spp at T) |"
     done
