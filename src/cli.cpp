@@ -355,6 +355,12 @@ int run_render(const render_options& o) {
       throw usage_error("--frames needs a frame pattern in --log" + how + o.log);
     if (!o.reference.empty() && !is_frame_pattern(o.reference))
       throw usage_error("--frames needs a frame pattern in --reference" + how + o.reference);
+  } else {
+    // A still render writes a name as given: a frame pattern there is likely a forgotten --frames.
+    for (const std::string& out : outputs)
+      if (is_frame_pattern(out))
+        std::fprintf(stderr, "bayeslight: warning: -o %s is a frame pattern, but without --frames the render is one "
+                     "image, written under that name as it stands\n", out.c_str());
   }
   warn_unused_options(o, {kind});
   // Every frame's files (a folder that exists for frame 0 only would fail them after their renders).

@@ -217,6 +217,12 @@ TEST_CASE("without --frames an output name is taken literally, % and all", "[ani
   CHECK(std::filesystem::exists(log));
   CHECK_FALSE(std::filesystem::exists(a.dir / "still_0.pfm"));
   CHECK_FALSE(std::filesystem::exists(a.dir / "still_00.csv"));
+  // ... with a warning, even under --quiet (a forgotten --frames), for an image; a name with a '%' that is no frame
+  // pattern draws none.
+  CHECK(r.output.find("warning: -o " + pattern + " is a frame pattern, but without --frames") != std::string::npos);
+  auto plain = run_bayeslight("render " + scene + " --spp 2 --quiet -o " + (a.dir / "100%.pfm"));
+  REQUIRE(plain.status == 0);
+  CHECK(plain.output.find("warning") == std::string::npos);
 }
 
 TEST_CASE("an animation of one frame (--frames 1) takes frame patterns, and a '%' in a name is written %%",
