@@ -55,28 +55,26 @@ struct hasher {
   }
 };
 
-// Hashes the fingerprint as one sequence (the total) and each part alone: values go to both.
+// Hashes the fingerprint as one sequence (the total) and each part alone: a value goes to the total and to the part
+// begun last (or, value_in, to another part: the total's order stays that of the fingerprint before its parts).
 struct part_hasher {
-  hasher total, part;
-  render_fingerprint_data* out;
-  int current = -1;
-  void begin(int p) {
-    finish();
-    current = p, part = hasher{};
-  }
-  void finish() {
-    if (current >= 0) out->parts[current] = part.h;
-    current = -1;
-  }
-  void bytes(const void* data, size_t n) { total.bytes(data, n), part.bytes(data, n); }
+  hasher total;
+  hasher parts[fp_part_count];
+  int current = 0;
+  void begin(int p) { current = p; }
+  void bytes(const void* data, size_t n) { total.bytes(data, n), parts[current].bytes(data, n); }
   template <class T>
   void value(const T& v) {
-    total.value(v), part.value(v);
+    total.value(v), parts[current].value(v);
   }
-  void vec(vec3f v) { total.vec(v), part.vec(v); }
+  template <class T>
+  void value_in(int part, const T& v) {
+    total.value(v), parts[part].value(v);
+  }
+  void vec(vec3f v) { total.vec(v), parts[current].vec(v); }
   template <class T>
   void column(const std::vector<T>& v) {
-    total.column(v), part.column(v);
+    total.column(v), parts[current].column(v);
   }
 };
 
@@ -352,9 +350,10 @@ const char* fingerprint_part_name(int part) {
     case fp_seed: return "the seed";
     case fp_sampler: return "the sampler";
     case fp_light_samples: return "the light samples (--independent-samples, --light-samples)";
-    case fp_animation: return "the animation (--frames, the sun's direction_end, --frame-decay, --spp or --time)";
-    case fp_pass_weighting: return "--pass-weighting";
-    case fp_regions: return "the region options (--grid, --max-cut, --cut-*, --region-*, --shared-cut-lights)";
+    case fp_animation: return "the animation (--frames, the sun's direction_end, --spp or --time)";
+    case fp_learning_weights: return "--pass-weighting or --frame-decay";
+    case fp_regions:
+      return "the region options (--grid, --max-cut, --cut-*, --region-*, --shared-cut-lights, --fine-depth)";
     case fp_bayes: return "the bayes options (--bayes-*)";
     case fp_donikian: return "the donikian options";
     default: return "?";
@@ -362,8 +361,7 @@ const char* fingerprint_part_name(int part) {
 }
 
 render_fingerprint_data render_fingerprint(const scene_data& scene, const render_params& p) {
-  render_fingerprint_data f;
-  part_hasher h{{}, {}, &f};
+  part_hasher h;
   h.begin(fp_scene);
   const mesh_data& m = scene.mesh;
   h.column(m.positions);
@@ -406,7 +404,8 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
     // An animation: its frame count and the sun's end (each frame's sun), and, for a learning sampler, how much of
     // its statistics a frame keeps. (A still's fingerprint is what it was before animations could be resumed.)
     h.value(p.frames), h.value(scene.sun.animated), h.vec(scene.sun.direction_end);
-    if (k == sampler_kind::bayes || k == sampler_kind::donikian) h.value(p.frame_decay);
+    // (With the learning's other weight: only the learning samplers read it, and another sampler names itself.)
+    if (k == sampler_kind::bayes || k == sampler_kind::donikian) h.value_in(fp_learning_weights, p.frame_decay);
     // And its samples per frame: the frames before the checkpoint's were rendered with them, and a learning sampler's
     // later frames start from what those learned (a resume with another --spp was taken silently; a review).
     h.value(p.time_budget);
@@ -418,7 +417,7 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
   // Nor the options the others leave without effect (as the command line's warning names them: a resume with
   // --pass-weighting 8 of a --bayes-oracle render was refused right after the warning said it was ignored; a review).
   const bool frozen = k == sampler_kind::bayes && p.sampler.bayes.oracle_spp > 0;
-  h.begin(fp_pass_weighting);
+  h.begin(fp_learning_weights);
   if ((k == sampler_kind::donikian || k == sampler_kind::bayes) && !frozen) h.value(p.pass_weighting);  // adaptive
   h.begin(fp_regions);
   if (regions) {
@@ -452,8 +451,9 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
     const donikian_params& d = p.sampler.donikian;
     h.value(d.block), h.value(d.pixel_half), h.value(d.min_share);
   }
-  h.finish();
+  render_fingerprint_data f;
   f.total = h.total.h;
+  for (int p = 0; p < fp_part_count; p++) f.parts[p] = h.parts[p].h;
   return f;
 }
 
@@ -534,7 +534,10 @@ static void emit_checkpoint(writer& w, const render_fingerprint_data& fingerprin
   w.value(reference);
   w.value(uint32_t(sampler.index()));
   w.value(result.width), w.value(result.height);
-  if (frames > 1) w.value(result.frame);  // (an animation's only: a still's checkpoint is as it was)
+  if (frames > 1) {  // (an animation's only)
+    w.value(result.frame);
+    w.value(uint8_t(result.fallback_earlier));  // (bayes fell back in an earlier frame: its summary says so)
+  }
   w.value(result.passes), w.value(result.spp), w.value(result.stratum_base);
   w.value(result.seconds);
   w.value(result.stats);
@@ -582,23 +585,26 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   const uint32_t kind = r.value<uint32_t>();
   int w = r.value<int>(), hgt = r.value<int>();
   if (total != fingerprint.total) {
-    // Name what differs (the parts whose hashes differ; the image size as saved, the likeliest slip).
+    // Name what differs (the parts whose hashes differ; the image size as saved, the likeliest slip). Another
+    // sampler brings its own options, and the region options' automatic values follow the image size and the depth:
+    // those are not named too.
     std::string which;
-    int count = 0;
-    // (Another sampler brings its own options: they are not named too.)
-    const bool sampler = saved.parts[fp_sampler] != fingerprint.parts[fp_sampler];
-    for (int p = 0; p < fp_part_count; p++)
-      if (saved.parts[p] != fingerprint.parts[p] && !(sampler && p >= fp_pass_weighting)) {
-        which += std::string(count++ ? ", " : "") + fingerprint_part_name(p);
-        if (p == fp_image_size) which += " (" + std::to_string(w) + "x" + std::to_string(hgt) + " there)";
-      }
+    auto differs = [&](int p) { return saved.parts[p] != fingerprint.parts[p]; };
+    for (int p = 0; p < fp_part_count; p++) {
+      if (!differs(p) || (differs(fp_sampler) && p >= fp_learning_weights) ||
+          (p == fp_regions && (differs(fp_image_size) || differs(fp_max_depth))))
+        continue;
+      which += std::string(which.empty() ? "" : ", ") + fingerprint_part_name(p);
+      if (p == fp_image_size) which += " (" + std::to_string(w) + "x" + std::to_string(hgt) + " there)";
+    }
     throw input_error(path, "checkpoint was written for a different scene or different render options" +
-                                (count > 0 ? ": " + which + (count > 1 ? " differ" : " differs") : std::string()));
+                                (which.empty() ? std::string() : "; what differs: " + which));
   }
   if (kind != uint32_t(sampler.index())) r.fail("sampler kind");
   if (w != result.width || hgt != result.height) r.fail("image size");
   result.frame = params.frames > 1 ? r.value<int>() : 0;
   if (result.frame < 0 || result.frame >= std::max(1, params.frames)) r.fail("frame");
+  result.fallback_earlier = params.frames > 1 && r.value<uint8_t>() != 0;
   result.passes = r.value<int>();
   result.spp = r.value<int>();
   result.stratum_base = r.value<int>();

@@ -9,6 +9,7 @@
 #include "render.h"
 #include "scene.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -19,17 +20,21 @@ namespace bl {
 // (geometry, materials, textures, camera, sun) and the options that affect pixels (size, depth, seed, sampler
 // and its parameters). The spp target and time budget are not part of it (but for an animation's): a render may be
 // resumed further. With the hash of each part, so that a refused resume names the parts that differ.
-enum fingerprint_part : int {  // (from fp_pass_weighting on: options of the sampler in use)
-  fp_scene, fp_image_size, fp_max_depth, fp_seed, fp_sampler, fp_light_samples, fp_animation, fp_pass_weighting,
+enum fingerprint_part : int {  // (from fp_learning_weights on: options of the sampler in use)
+  fp_scene, fp_image_size, fp_max_depth, fp_seed, fp_sampler, fp_light_samples, fp_animation, fp_learning_weights,
   fp_regions, fp_bayes, fp_donikian, fp_part_count
 };
 struct render_fingerprint_data {
   uint64_t total = 0;                  // of everything, in order (what a checkpoint must match)
-  uint64_t parts[fp_part_count] = {};  // of each part alone (0: a part with nothing in it)
+  uint64_t parts[fp_part_count] = {};  // of each part alone (a part with nothing in it: the hasher's start value)
 };
 render_fingerprint_data render_fingerprint(const scene_data& scene, const render_params& params);
 // What part `part` covers, as a refusal names it.
 const char* fingerprint_part_name(int part);
+
+// Where an animation's checkpoint holds its frame index: after the magic (16 bytes), the version, the fingerprint and
+// its parts, the reference hash, the sampler kind, the width and the height (tests edit it).
+constexpr size_t checkpoint_frame_offset = 16 + 4 + 8 + 4 + 8 * fp_part_count + 8 + 4 + 4 + 4;
 
 // The version of the checkpoint layout: a checkpoint of another one is refused (bayeslight --version says it).
 uint32_t checkpoint_format_version();

@@ -357,7 +357,7 @@ int run_render(const render_options& o) {
       throw usage_error("--frames needs a frame pattern in --reference" + how + o.reference);
   } else {
     // A still render writes a name as given: a frame pattern there is likely a forgotten --frames.
-    for (const std::string& out : outputs)
+    for (const std::string& out : o.outputs)  // (as given: a scene named with one gives its default output one too)
       if (is_frame_pattern(out))
         std::fprintf(stderr, "bayeslight: warning: -o %s is a frame pattern, but without --frames the render is one "
                      "image, written under that name as it stands\n", out.c_str());
@@ -431,38 +431,49 @@ int run_render(const render_options& o) {
       // (a review: 343 MB against 222 MB resident).
       std::string().swap(resume_bytes);
       const uint64_t reference_key = reference_keys[size_t(r.frame)];
+      // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
+      if (params.time_budget <= 0 && r.spp > params.spp)
+        throw usage_error((o.spp > 0 ? "--spp " + std::to_string(params.spp)
+                                     : "the scene's render.spp (" + std::to_string(params.spp) + ")") +
+                          " is below the " + std::to_string(r.spp) + " spp already in " + o.resume + ": give --spp " +
+                          std::to_string(r.spp) + " or more, or --time");
       // An animation's checkpoint of frame k: frames 0 to k - 1 were written by the render that saved it (they are not
       // rendered again: frame k needs what they learned, and their state is gone).
-      if (r.frame > 0) {
-        std::string missing;
-        int count = 0;
-        for (int f = 0; f < r.frame; f++)
-          for (const std::string& out : outputs) {
-            std::string file = frame_path(out, f, animated);
-            if (!fs::exists(file) && count++ == 0) missing = file;
-          }
-        if (count > 0 || !o.quiet)
-          std::fprintf(stderr, "%s: resuming the animation at frame %d of %d (%s rendered before)%s\n",
-                       o.resume.c_str(), r.frame, params.frames, frames_were(0, r.frame - 1).c_str(),
-                       count == 0 ? ""
-                                  : ("; warning: " + missing +
-                                     (count > 1 ? " and " + std::to_string(count - 1) + " more of those frames' files are"
-                                                : " is") +
-                                     " missing (a frame cannot be rendered alone: render the animation again for it)")
-                                        .c_str());
-      }
-      // A still render (or an animation's first frame) says what it continues, and what --time leaves of its budget:
-      // the budget is the render's total, the checkpoint's seconds included.
+      std::string missing;
+      int count = 0;
+      for (int f = 0; f < r.frame; f++)
+        for (const std::string& out : outputs) {
+          std::string file = frame_path(out, f, animated);
+          if (!fs::exists(file) && count++ == 0) missing = file;
+        }
+      // What the render continues, and what it adds: its spp, seconds and --time budget count the checkpoint's (an
+      // animation's: those of the frame under way).
       const bool budget_spent = params.time_budget > 0 && r.seconds >= params.time_budget;
-      if (r.frame == 0 && !o.quiet) {
-        char budget[160] = "";
+      if (count > 0 || !o.quiet) {
+        const std::string none = animated ? "frame " + std::to_string(r.frame) + " adds no pass" : "no pass is added";
+        char at[160], budget[160] = "";
+        if (animated)
+          std::snprintf(at, sizeof at, "the animation at frame %d of %d, %d spp into it (%d pass%s, %.3g s%s)", r.frame,
+                        params.frames, r.spp, r.passes, r.passes == 1 ? "" : "es", r.seconds,
+                        r.frame > 0 ? ("; " + frames_were(0, r.frame - 1) + " rendered before").c_str() : "");
+        else
+          std::snprintf(at, sizeof at, "at %d spp (%d pass%s, %.3g s rendered before)", r.spp, r.passes,
+                        r.passes == 1 ? "" : "es", r.seconds);
         if (budget_spent)
-          std::snprintf(budget, sizeof budget, "; --time %g counts them and is spent: no pass is added", params.time_budget);
+          std::snprintf(budget, sizeof budget, "; --time %g counts them and is spent: %s", params.time_budget,
+                        none.c_str());
         else if (params.time_budget > 0)
-          std::snprintf(budget, sizeof budget, "; --time %g counts them: %.2f s left", params.time_budget,
+          std::snprintf(budget, sizeof budget, "; --time %g counts them: %.3g s left", params.time_budget,
                         params.time_budget - r.seconds);
-        std::fprintf(stderr, "%s: resuming at %d spp (%d pass%s, %.2f s rendered before)%s\n", o.resume.c_str(), r.spp,
-                     r.passes, r.passes == 1 ? "" : "es", r.seconds, budget);
+        else if (params.spp == r.spp)
+          std::snprintf(budget, sizeof budget, "; --spp %d: %s", params.spp, none.c_str());
+        std::fprintf(stderr, "%s: resuming %s%s%s\n", o.resume.c_str(), at, budget,
+                     count == 0 ? ""
+                                : ("; warning: " + missing +
+                                   (count > 1 ? " and " + std::to_string(count - 1) + " more of those frames' files are"
+                                              : " is") +
+                                   " missing (a frame cannot be rendered alone: render the animation again for it)")
+                                      .c_str());
       }
       // The log is one error curve against one reference: rows measured against another one (or none) keep their
       // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
@@ -490,12 +501,6 @@ int run_render(const render_options& o) {
                      "%s: warning: its pass ending at %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 "
                      "... do): the continued image is correct, but not bit-identical to one render of the final spp\n",
                      o.resume.c_str(), off);
-      // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
-      if (params.time_budget <= 0 && r.spp > params.spp)
-        throw usage_error((o.spp > 0 ? "--spp " + std::to_string(params.spp)
-                                     : "the scene's render.spp (" + std::to_string(params.spp) + ")") +
-                          " is below the " + std::to_string(r.spp) + " spp already in " + o.resume + ": give --spp " +
-                          std::to_string(r.spp) + " or more, or --time");
     };
   auto last_write = std::chrono::steady_clock::now();
   // A checkpoint that cannot be written (a full disk) is reported and the render goes on: its image is still

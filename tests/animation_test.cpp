@@ -223,6 +223,13 @@ TEST_CASE("without --frames an output name is taken literally, % and all", "[ani
   auto plain = run_bayeslight("render " + scene + " --spp 2 --quiet -o " + (a.dir / "100%.pfm"));
   REQUIRE(plain.status == 0);
   CHECK(plain.output.find("warning") == std::string::npos);
+  // Nor does the default output of a scene whose name is one (no -o was given: nothing was forgotten).
+  std::filesystem::copy_file(scene, a.dir / "sc_%d.json");
+  auto named = run_bayeslight("render " + (a.dir / "sc_%d.json") + " --spp 2 --width 8 --height 6 --quiet");
+  REQUIRE(named.status == 0);
+  CHECK(named.output.find("warning") == std::string::npos);
+  CHECK(std::filesystem::exists("sc_%d.exr"));
+  std::filesystem::remove("sc_%d.exr");
 }
 
 TEST_CASE("an animation of one frame (--frames 1) takes frame patterns, and a '%' in a name is written %%",
@@ -357,21 +364,20 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
   CHECK(run_bayeslight(base + " --frames 4 --resume " + ck).status == 3);
   auto decay = run_bayeslight(args + " --frame-decay 0.7 --resume " + ck);
   CHECK(decay.status == 3);
-  CHECK(decay.output.find(": the animation (--frames, the sun's direction_end, --frame-decay, --spp or --time) differs") !=
-        std::string::npos);  // (the message named every option but --frame-decay)
+  CHECK(decay.output.find("; what differs: --pass-weighting or --frame-decay\n") != std::string::npos);
+  // (the message named every option but --frame-decay)
   // Nor with other samples per frame: frame 0 was rendered with 27 spp and frame 1 learned from it.
   auto more = run_bayeslight("render " + anim + " --spp 40 --frames 3 --quiet -o " + (a.dir / "part_%d.pfm") +
                              " --resume " + ck);
   CHECK(more.status == 3);
-  CHECK(more.output.find(": the animation (--frames, the sun's direction_end, --frame-decay, --spp or --time) differs") !=
+  CHECK(more.output.find("; what differs: the animation (--frames, the sun's direction_end, --spp or --time)\n") !=
         std::string::npos);
   CHECK(run_bayeslight("render " + anim + " --spp 27 --quiet -o " + (a.dir / "still.pfm") + " --resume " + ck).status == 3);
-  // The frame index (after magic, version, fingerprint and its parts, reference hash, sampler kind, width and
-  // height) edited out of range and the file re-sealed with its checksum: refused, never followed.
+  // The frame index edited out of range and the file re-sealed with its checksum: refused, never followed.
   const std::string saved = read_file(ck);
   for (int bad : {-1, 3, 1 << 30}) {
     std::string body = saved.substr(0, saved.size() - 8);
-    std::memcpy(&body[16 + 4 + 8 + 4 + 8 * fp_part_count + 8 + 4 + 4 + 4], &bad, sizeof bad);
+    std::memcpy(&body[checkpoint_frame_offset], &bad, sizeof bad);
     uint64_t h = checkpoint_checksum(body);
     write_text(a.dir / "edited.bin", body + std::string(reinterpret_cast<const char*>(&h), 8));
     auto e = run_bayeslight(args + " --resume " + (a.dir / "edited.bin"));
@@ -382,6 +388,8 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
   std::filesystem::remove(frame("part", 0));
   auto r = run_bayeslight(args + " --resume " + ck);
   CHECK(r.status == 0);
-  CHECK(r.output.find("resuming the animation at frame 1 of 3") != std::string::npos);
+  CHECK(r.output.find("resuming the animation at frame 1 of 3, ") != std::string::npos);
+  CHECK(r.output.find(" spp into it (") != std::string::npos);
+  CHECK(r.output.find("; frame 0 was rendered before)") != std::string::npos);
   CHECK(r.output.find("part_0.pfm is missing") != std::string::npos);
 }

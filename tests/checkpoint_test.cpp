@@ -76,6 +76,7 @@ TEST_CASE("a resumed render says what it continues and what --time leaves", "[ch
   REQUIRE(more.status == 0);
   CHECK(more.output.find(ck + ": resuming at 20 spp (") != std::string::npos);
   CHECK(more.output.find("rendered 40 spp") != std::string::npos);
+  CHECK(more.output.find(" clusters or members per region") != std::string::npos);  // (members: beyond --max-cut)
   auto spent = run_bayeslight(loud + " --time 0.000001 --resume " + ck + " -o " + (d / "c.pfm"));
   INFO(spent.output);
   REQUIRE(spent.status == 0);
@@ -83,8 +84,16 @@ TEST_CASE("a resumed render says what it continues and what --time leaves", "[ch
   CHECK(spent.output.find("not bit-identical") == std::string::npos);
   CHECK(spent.output.find("rendered 20 spp") != std::string::npos);
   CHECK(read_file(d / "c.pfm") == read_file(d / "a.pfm"));
+  auto same = run_bayeslight(loud + " --spp 20 --resume " + ck + " -o " + (d / "c.pfm"));
+  REQUIRE(same.status == 0);
+  CHECK(same.output.find("; --spp 20: no pass is added") != std::string::npos);
   auto quiet = run_bayeslight(args + " --spp 40 --resume " + ck + " -o " + (d / "b.pfm"));
+  CHECK(quiet.status == 0);
   CHECK(quiet.output.find("resuming") == std::string::npos);
+  // A resume refused for its --spp says nothing of resuming (it had said "resuming at 20 spp" first).
+  auto fewer = run_bayeslight(loud + " --spp 10 --resume " + ck + " -o " + (d / "b.pfm"));
+  CHECK(fewer.status == 2);
+  CHECK(fewer.output.find("resuming") == std::string::npos);
 }
 
 TEST_CASE("a checkpoint written in pieces resumes to the same bytes", "[checkpoint]") {
@@ -235,23 +244,25 @@ TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[ch
     std::string args, differs;
   };
   for (const other_render& other :
-       {other_render{base_args("bayes") + " --seed 5", ": the seed differs"},
-        other_render{base_args("bayes") + " --max-depth 2", ": --max-depth differs"},
-        other_render{base_args("bound"), ": the sampler differs"},
-        other_render{base_args("bound") + " --seed 5", ": the seed, the sampler differ"},
-        other_render{base_args("bayes") + " --bayes-b0 2", ": the bayes options (--bayes-*) differs"},
+       {other_render{base_args("bayes") + " --seed 5", "the seed"},
+        other_render{base_args("bayes") + " --max-depth 2", "--max-depth"},
+        other_render{base_args("bound"), "the sampler"},  // (its options come with it)
+        other_render{base_args("bound") + " --seed 5", "the seed, the sampler"},
+        other_render{base_args("bayes") + " --bayes-b0 2", "the bayes options (--bayes-*)"},
         other_render{base_args("bayes") + " --light-samples 2",
-                     ": the light samples (--independent-samples, --light-samples) differs"},
-        other_render{base_args("bayes") + " --grid 16", ": the region options ("},
-        other_render{size_args, ": the image size (40x30 there)"},
+                     "the light samples (--independent-samples, --light-samples)"},
+        other_render{base_args("bayes") + " --grid 16",
+                     "the region options (--grid, --max-cut, --cut-*, --region-*, --shared-cut-lights, --fine-depth)"},
+        // (the automatic pair budget follows the image size: the region options are not named too)
+        other_render{size_args, "the image size (40x30 there)"},
         other_render{"render " + source_path("data/cornell/path.json") +
                          " --sampler bayes --width 40 --height 30 --spp 30 --quiet",
-                     ": the scene (its mesh, materials, textures, camera, sun or two_sided_emitters)"}}) {
+                     "the scene (its mesh, materials, textures, camera, sun or two_sided_emitters)"}}) {
     auto r = run_bayeslight(other.args + " -o " + (d / "x.pfm") + " --resume " + ck);
     INFO(other.args << "\n" << r.output);
     CHECK(r.status == 3);
-    CHECK(r.output.find("ck.bin: checkpoint was written for a different scene or different render options" +
-                        other.differs) != std::string::npos);
+    CHECK(r.output.find("ck.bin: checkpoint was written for a different scene or different render options; what "
+                        "differs: " + other.differs + "\n") != std::string::npos);
     CHECK(!std::filesystem::exists(d / "x.pfm"));
   }
   // A flipped byte, a truncated file, a file that is not a checkpoint.
@@ -344,8 +355,7 @@ struct checkpoint_fields {
 };
 checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   checkpoint_fields f{};
-  // magic, version, fingerprint (total, part count, parts), reference hash, sampler kind, width, height
-  c.pos = 16 + 4 + 8 + 4 + 8 * fp_part_count + 8 + 4 + 4 + 4;
+  c.pos = checkpoint_frame_offset;  // (a still's checkpoint has no frame index: its passes follow)
   f.passes = c.value(4);
   c.value(4 + 4 + 8 + 6 * 8);  // spp, stratum base, seconds, counters
   uint64_t log = c.get<uint64_t>(c.value(8));

@@ -1230,7 +1230,10 @@ TEST_CASE("an unwritable output is reported before rendering", "[cli]") {
   const std::string long_name = std::string(300, 'a');
   for (const std::string& bad : {"-o " + (s.dir / (long_name + ".exr")), "--log " + (s.dir / (long_name + ".csv")),
                                  "--checkpoint " + (s.dir / (long_name + ".ck"))}) {
-    const std::string other = bad.rfind("--log", 0) == 0 ? " -o " + (s.dir / "ok.pfm") : " --log " + (s.dir / "ok.csv");
+    // (and an image in the test's folder, else the default output lands in the working directory)
+    const std::string other = bad.rfind("-o", 0) == 0 ? " --log " + (s.dir / "ok.csv")
+                              : bad.rfind("--log", 0) == 0 ? " -o " + (s.dir / "ok.pfm")
+                                                           : " -o " + (s.dir / "ok.pfm") + " --log " + (s.dir / "ok.csv");
     r = run_bayeslight("render " + s.json + " --quiet --spp 1 --width 8 --height 6 " + bad + other);
     INFO(bad.substr(0, 12) << "\n" << r.output);
     CHECK(r.status == 1);

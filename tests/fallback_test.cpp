@@ -253,6 +253,19 @@ TEST_CASE("bayes falls back where learning cannot pay and not where it does", "[
   CHECK(frames.output.find("frame 0: rendered") != std::string::npos);
   CHECK(frames.output.find("power sampling after 12 spp") < frames.output.find("frame 1: rendered"));
   CHECK(frames.output.find("power sampling since an earlier frame (after 12 spp of it)") != std::string::npos);
+  // ... also once resumed from a checkpoint of frame 1 (the checkpoint keeps it: the summary read as frame 1's own).
+  const std::string anim = "render " + source_path("data/cornell/path.json") +
+                           " --width 320 --height 240 --spp 15 --frames 2 -o " + (d / "frame_%d.pfm") +
+                           " --checkpoint " + (d / "ck.bin") + " --checkpoint-every 0";
+  auto stopped = run_bayeslight(anim + " --stop-after-passes 13");
+  INFO(stopped.output);
+  REQUIRE(stopped.status == 130);
+  auto resumed = run_bayeslight(anim + " --resume " + (d / "ck.bin"));
+  INFO(resumed.output);
+  REQUIRE(resumed.status == 0);
+  CHECK(resumed.output.find("resuming the animation at frame 1 of 2") != std::string::npos);
+  CHECK(resumed.output.find("frame 1: rendered 15 spp") != std::string::npos);
+  CHECK(resumed.output.find("power sampling since an earlier frame (after 12 spp of it)") != std::string::npos);
   // The ablation switch.
   auto off = run("cornell/path", "--bayes-fallback-ratio 0");
   REQUIRE(off.status == 0);

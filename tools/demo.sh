@@ -24,7 +24,7 @@ done
 echo
 echo "error against time (relMSE vs the reference; full per-pass curves in $out/*.csv):"
 for s in bayes bound; do
-  tail -n 1 "$out/living_room_$s.csv" | awk -F, '{printf "  %-6s %5d spp in %6.2f s  relMSE %.5g\n", $1, $3, $4, $5}'
+  tail -n 1 "$out/living_room_$s.csv" | awk -F, '{printf "  %-6s %5d spp in %6.2f s  relMSE %.5g (its last pass)\n", $1, $3, $4, $5}'
 done
 # Each render ends with the pass under way at T: the errors are compared at exactly T (interpolated between passes).
 read -r b _ < <(awk -F, -v T="$T" -f tools/at_time.awk "$out/living_room_bayes.csv")
