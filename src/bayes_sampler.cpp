@@ -158,6 +158,13 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
   }
   const bool grouped = ctx.pair_count != ctx.count;
   ctx.member_w = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
+  if (grouped) {
+    // sample_members reads the chosen cluster's bounds, its members' weights and the chosen member's node right after
+    // this: fetch the region's (consecutive, a few cache lines) while the weights below are computed.
+    auto fetch = [](const void* p) { _mm_prefetch(static_cast<const char*>(p), _MM_HINT_T0); };
+    for (int k = 0; k < ctx.pair_count; k += 16) fetch(ctx.member_w + k), fetch(ctx.members + k);
+    for (int k = 0; k < ctx.count; k += 16) fetch(ctx.member_begin + k);
+  }
   const float* W = grouped ? (ctx.cv ? stats.gw_cv.data() : stats.gw.data()) + ctx.group_base : ctx.member_w;
   ctx.group_w = W;
   ctx.group_total = grouped ? (ctx.cv ? stats.gtot_cv.data() : stats.gtot.data()) + ctx.group_base : nullptr;
@@ -173,7 +180,11 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
   };
   // sum_m colour_m cv_m of each cluster (its members' c_m = cv_m g_j share the factor g_j).
   const vec3f* gcol = grouped ? stats.gcol.data() + ctx.group_base : nullptr;
-  alignas(16) float wf[max_cut_entries + 3];
+  if (gcol && ctx.cv)  // (read below only for clusters with a learned mean, after their factors: fetched now)
+    for (int j = 0; j < ctx.count; j += 5) _mm_prefetch(reinterpret_cast<const char*>(gcol + j), _MM_HINT_T0);
+  // The weights, in double for the cdf, converted as each group of four is computed (w[count, count + 3): padding,
+  // never read).
+  alignas(16) double w[max_cut_entries + 3];
   float* gf = ctx.gfac;
   const int tc = ctx.tree_count;
   const __m128 px = _mm_set1_ps(sp.p.x), py = _mm_set1_ps(sp.p.y), pz = _mm_set1_ps(sp.p.z);
@@ -217,7 +228,9 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
     }
     g = _mm_and_ps(front, g);
     _mm_storeu_ps(gf + j0, g);
-    _mm_store_ps(wf + j0, _mm_mul_ps(_mm_loadu_ps(W + j0), g));
+    const __m128 wv = _mm_mul_ps(_mm_loadu_ps(W + j0), g);
+    _mm_store_pd(w + j0, _mm_cvtps_pd(wv));
+    _mm_store_pd(w + j0 + 2, _mm_cvtps_pd(_mm_movehl_ps(wv, wv)));
     const int lanes = tc - j0 >= 4 ? 0xf : (1 << (tc - j0)) - 1;  // the lanes of real clusters
     front_mask |= _mm_movemask_ps(_mm_cmpgt_ps(g, zero)) & lanes;
     if (ctx.cv) {
@@ -238,7 +251,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
     gf[tc] = front * std::min(1.0f, std::max(cos_bound, orientation_floor));
     if (gloss)
       gf[tc] *= _mm_cvtss_f32(gloss_factor4(sp, _mm_set1_ps(dot(sp.refl, lights->sun_dir)), _mm_set1_ps(sun_sin)));
-    wf[tc] = W[tc] * gf[tc];
+    w[tc] = double(W[tc] * gf[tc]);
     front_mask |= gf[tc] > 0;
     if (ctx.cv) {
       int sun_member = ctx.pair_count - 1;  // the sun: its cluster's only member, the last
@@ -256,13 +269,6 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
     // Every cluster lies behind the surface: no light can be sampled (what the fallbacks below would also find).
     std::fill(ctx.cdf, ctx.cdf + ctx.count + 1, 0.0);
     return;
-  }
-  alignas(16) double w[max_cut_entries + 3];
-  for (int j = ctx.count; j < ((ctx.count + 3) & ~3); j++) wf[j] = 0;  // padding lanes never written above
-  for (int j = 0; j < ctx.count; j += 4) {  // to double, four at a time (wf has room for the padding lanes)
-    __m128 x = _mm_load_ps(wf + j);
-    _mm_store_pd(w + j, _mm_cvtps_pd(x));
-    _mm_store_pd(w + j + 2, _mm_cvtps_pd(_mm_movehl_ps(x, x)));
   }
   // Defensive mixing with the prior-only pmf (mu0 g: the region's bound model; always a little for the naive
   // ablation, which can starve clusters).
@@ -308,17 +314,15 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
       z *= d * d;
     }
   }
-  // The accumulator of (region, j): cached in the context while it records into the same row state and region (a
-  // hash lookup only the first time).
+  // The accumulator of (region, j), in the row state's block of the region: the block is cached in the context while
+  // it records into the same row state and region (a hash lookup per change of region).
   if (ctx.rec_owner != &row || ctx.rec_generation != row.generation || ctx.rec_base != ctx.pair_base) {
     ctx.rec_owner = &row;
     ctx.rec_generation = row.generation;
     ctx.rec_base = ctx.pair_base;
-    std::fill(ctx.rec_slot, ctx.rec_slot + ctx.pair_count, -1);
+    ctx.rec_block = row.block_of(ctx.pair_base, ctx.pair_count);
   }
-  int& slot = ctx.rec_slot[j];
-  if (slot < 0) slot = row.slot_of(ctx.pair_base + j);
-  row.add_at(slot, z);
+  row.add_at(row.slot_at(ctx.rec_block, ctx.pair_base, j), z);
 }
 
 light_choice bayes_sampler::sample_members(const context& ctx, double u, double u_inner) const {

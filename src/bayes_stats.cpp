@@ -8,6 +8,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <xmmintrin.h>
 #include <cmath>
 
 namespace bl {
@@ -102,36 +103,43 @@ bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, doubl
 
 void bayes_row::clear() {
   requests.clear();
-  for (int h : used) slots[size_t(h)] = -1;
+  for (int h : used) slots[size_t(h)].first = -1;
   used.clear();
+  blocks.clear();
   acc.clear();
   generation++;
   check_pixel = -1;
   check_n = check_mean = check_m2 = 0;
 }
 
-int bayes_row::slot_of(int pair) {
-  if (2 * (acc.size() + 1) > slots.size()) {
+int bayes_row::block_of(int first, int count) {
+  // Fibonacci hashing of the first pair (regions' first pairs are distinct, tens apart).
+  auto home = [](int key, size_t mask) {
+    return size_t((uint64_t(uint32_t(key)) * 0x9e3779b97f4a7c15ull) >> 32) & mask;
+  };
+  if (2 * (used.size() + 1) > slots.size()) {
     // Grow and rehash (load <= 1/2).
     size_t n = std::max<size_t>(64, slots.size() * 2);
-    slots.assign(n, -1);
+    std::vector<block_slot> old(n, block_slot{-1, 0});
+    old.swap(slots);
     used.clear();
-    for (size_t i = 0; i < acc.size(); i++) {
-      size_t h = size_t(mix64(uint64_t(acc[i].pair))) & (n - 1);
-      while (slots[h] >= 0) h = (h + 1) & (n - 1);
-      slots[h] = int(i);
+    for (const block_slot& b : old) {
+      if (b.first < 0) continue;
+      size_t h = home(b.first, n - 1);
+      while (slots[h].first >= 0) h = (h + 1) & (n - 1);
+      slots[h] = b;
       used.push_back(int(h));
     }
   }
   size_t mask = slots.size() - 1;
-  size_t h = size_t(mix64(uint64_t(pair))) & mask;
-  while (slots[h] >= 0 && acc[size_t(slots[h])].pair != pair) h = (h + 1) & mask;
-  if (slots[h] < 0) {
-    slots[h] = int(acc.size());
+  size_t h = home(first, mask);
+  while (slots[h].first >= 0 && slots[h].first != first) h = (h + 1) & mask;
+  if (slots[h].first < 0) {
+    slots[h] = {first, int(blocks.size())};
     used.push_back(int(h));
-    acc.push_back({pair, invalid_id, 0, 0, 0, 0});
+    blocks.resize(blocks.size() + size_t(count), -1);
   }
-  return slots[h];
+  return slots[h].offset;
 }
 
 void bayes_row::add_at(int index, double z) {
@@ -208,8 +216,21 @@ std::vector<int> merge_rows(bayes_stats& s, std::vector<bayes_row>& rows, const 
     std::vector<int>& touched = mb.touched[b];
     touched.clear();
     const size_t lo = b * span;
+    // The pair an update goes to (its statistics and flag are fetched `ahead` updates early: they are scattered over
+    // the columns, and each update waits on their loads).
+    constexpr uint32_t ahead = 8;
+    auto target = [](const bayes_row& row, uint32_t k) {
+      uint32_t t = row.order[k];
+      const pair_accum& a = row.acc[t >> 1];
+      return (t & 1) ? a.up : a.pair;
+    };
     for (const bayes_row& row : rows)
       for (uint32_t k = row.start[b], e = row.start[b + 1]; k < e; k++) {
+        if (k + ahead < e) {
+          int next = target(row, k + ahead);
+          _mm_prefetch(reinterpret_cast<const char*>(&s.m[size_t(next)]), _MM_HINT_T0);
+          _mm_prefetch(reinterpret_cast<const char*>(&mb.seen[size_t(next)]), _MM_HINT_T0);
+        }
         uint32_t t = row.order[k];
         const pair_accum& a = row.acc[t >> 1];
         int pair = (t & 1) ? a.up : a.pair;

@@ -273,10 +273,17 @@ struct pair_accum {
   double n0, n1, mean, m2;
 };
 
-// The per-row state of the Bayesian sampler: region requests and pair accumulators (open addressing).
+// The per-row state of the Bayesian sampler: region requests and pair accumulators. A region's pairs are consecutive,
+// so accumulators are found by region: per region recorded into, a block of accumulator indices, one per pair (-1:
+// none yet), found by the region's first pair (open addressing): one lookup per change of region, none per pair.
 struct bayes_row {
+  struct block_slot {
+    int first;   // the block's first pair (-1: empty slot)
+    int offset;  // the block's offset in `blocks`
+  };
   region_requests requests;
-  std::vector<int> slots;        // power-of-two table of indices into acc (-1: empty)
+  std::vector<block_slot> slots; // power-of-two table of blocks
+  std::vector<int> blocks;       // per block, per pair of it: index into acc (-1: none yet)
   std::vector<pair_accum> acc;   // in first-touch order (deterministic within the row)
   std::vector<int> used;         // slots in use (cleared one by one: cheaper than refilling the table)
   std::vector<uint32_t> order;   // merge_rows: the row's updates (acc index * 2 + 1 for the parent's) by bucket
@@ -289,8 +296,23 @@ struct bayes_row {
   // The sum over the current pixel's samples of their variance: n s^2 with s^2 the unbiased sample variance.
   double check_pending() const { return check_n >= 2 ? check_m2 * check_n / (check_n - 1) : 0.0; }
   void clear();
-  // Index in acc of pair's accumulator (created empty if absent).
-  int slot_of(int pair);
+  // Offset in `blocks` of the block of pairs [first, first + count) (a region's; created if absent). A block is
+  // always asked for with the same count while the row state is not cleared (regions are frozen during a pass).
+  int block_of(int first, int count);
+  // Index in acc of the accumulator of pair first + j of the block at `offset` (created empty if absent).
+  int slot_at(int offset, int first, int j) {
+    int& s = blocks[size_t(offset + j)];
+    if (s < 0) {
+      s = int(acc.size());
+      pair_accum& a = acc.emplace_back();  // (zeroed in place: a temporary's copy stalled on its own stores)
+      a.pair = first + j;
+      a.up = invalid_id;
+    }
+    return s;
+  }
+  // Index in acc of pair's accumulator (created empty if absent), in a block of its own (a row records either
+  // through regions' blocks, bayes_sampler::record, or pair by pair, not both).
+  int slot_of(int pair) { return slot_at(block_of(pair, 1), pair, 0); }
   // Adds sample z to accumulator acc[index] (Welford).
   void add_at(int index, double z);
   void add(int pair, double z) { add_at(slot_of(pair), z); }

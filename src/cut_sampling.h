@@ -52,12 +52,12 @@ struct cut_context {
   // The point factor of each cluster (bayes, region prior): 1 / d^2 times the receiver's cosine bound toward the
   // cluster; 0 behind the surface. A sample z = Y / factor is what the pair's statistics learn.
   float gfac[max_cut_entries + 3];
-  // Recording cache (bayes): the row-state accumulator of each cluster of the current region, valid while the
-  // same row state (and generation of it) and region are recorded into; -1: not looked up yet.
+  // Recording cache (bayes): the row state's block of accumulators of the current region, valid while the same row
+  // state (and generation of it) and region are recorded into.
   mutable const void* rec_owner = nullptr;
   mutable uint64_t rec_generation = 0;
   mutable int rec_base = -1;
-  mutable int rec_slot[max_cut_entries];
+  mutable int rec_block = 0;
 };
 
 // Fills the point and region part of a context. The region part is kept while the cell stays the same (contexts
