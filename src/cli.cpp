@@ -416,7 +416,9 @@ int run_render(const render_options& o) {
                  std::chrono::duration<double>(t_end - t_bvh).count());
   }
 
-  const render_fingerprint_data fingerprint = render_fingerprint(scene, params);
+  // (Hashed only for a checkpoint or a resume: every mesh value is hashed twice, for the total and for its part.)
+  const render_fingerprint_data fingerprint =
+      o.checkpoint.empty() && o.resume.empty() ? render_fingerprint_data{} : render_fingerprint(scene, params);
   // Per frame: the hash of the reference a frame's logged errors are measured against (0: none).
   std::vector<uint64_t> reference_keys;
   for (int f = 0; f < params.frames; f++)
