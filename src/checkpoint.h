@@ -58,6 +58,7 @@ void write_checkpoint(const std::string& path, const render_fingerprint_data& fi
 // `params`: the render's, against whose pass weighting the film's weight is checked and whose frame count bounds
 // an animation's frame. Returns the stored reference hash.
 uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
-                           const render_fingerprint_data& fingerprint, const render_params& params, render_result& result, light_sampler& sampler);
+                           const render_fingerprint_data& fingerprint, const render_params& params,
+                           render_result& result, light_sampler& sampler);
 
 }  // namespace bl

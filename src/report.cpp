@@ -56,8 +56,8 @@ std::string render_summary(const render_result& r, const std::vector<std::string
       std::snprintf(buf, sizeof buf, "; 1 region, %.0f clusters or members, %.1f MB sampler state", double(r.pairs),
                     double(r.sampler_bytes) / (1 << 20));
     else
-      std::snprintf(buf, sizeof buf, "; %d regions, %.1f clusters or members per region, %.1f MB sampler state", r.regions,
-                    double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));
+      std::snprintf(buf, sizeof buf, "; %d regions, %.1f clusters or members per region, %.1f MB sampler state",
+                    r.regions, double(r.pairs) / r.regions, double(r.sampler_bytes) / (1 << 20));
     s += buf;
   }
   if (r.fallback_spp > 0 && r.fallback_earlier) {

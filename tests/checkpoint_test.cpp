@@ -239,7 +239,8 @@ TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[ch
   REQUIRE(run_bayeslight(base_args("bayes") + " -o " + (d / "a.pfm") + " --checkpoint " + ck).status == 0);
   // Each refusal names what differs (it had said only "a different scene or different render options", whatever the
   // slip: a forgotten --width, another seed).
-  const std::string size_args = "render " + source_path("data/living_room/path.json") + " --sampler bayes --spp 27 --quiet";
+  const std::string size_args =
+      "render " + source_path("data/living_room/path.json") + " --sampler bayes --spp 27 --quiet";
   struct other_render {
     std::string args, differs;
   };
