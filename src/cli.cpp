@@ -328,7 +328,7 @@ int run_render(const render_options& o) {
   auto t_load = std::chrono::steady_clock::now();
   std::optional<slow_phase_note> loading(std::in_place, params.notes, "loading " + o.scene + " ...");
   scene_data scene = build_scene(desc, float(params.width) / float(params.height));
-  report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
+  report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate, scene.mesh.first_degenerate_line);
   {
     std::vector<std::pair<std::string, std::string>> outs, ins = {{o.scene, "scene file"}};
     for (int f = 0; f < params.frames; f++) {

@@ -388,7 +388,7 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   image_data reference = read_reference(params.reference_path, rp.width, rp.height);
   std::optional<slow_phase_note> loading(std::in_place, rp.notes, "loading " + desc.path + " ...");
   scene_data scene = build_scene(desc, float(rp.width) / float(rp.height));
-  report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate);
+  report_dropped_triangles(desc.mesh_path, scene.mesh.dropped_degenerate, scene.mesh.first_degenerate_line);
   {
     // The files written into --out must not be inputs (e.g. a reference kept there as <sampler>.exr).
     std::vector<std::pair<std::string, std::string>> outs, ins = {{params.scene_path, "scene file"},

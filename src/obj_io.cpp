@@ -183,16 +183,23 @@ corner_key triangle_corner_key(const std::vector<vec3f>& positions, const int* c
   return key;
 }
 
+// Triangles drop_repeated_triangles dropped of one kind: how many, the first in file order, the copy it repeats.
+struct repeat_drops {
+  int count = 0;
+  int first = 0, kept = 0;  // triangle indices before the drop
+};
+
 // Drops triangles that repeat another exactly (the same three corners in the same cyclic order: the same side).
 // An emissive repeat would be counted by light sampling once per copy while a ray sees one (next-event and
 // BSDF-sampled estimates of that light would disagree); any repeat makes rays test every copy (Embree cannot split
 // identical boxes: 400k copies cost a millisecond per ray) and leaves which copy a ray reports, with its material,
 // to the traversal. Of each set of repeats the first emissive one stays, else the first. Where a copy has a map_d
 // cut-out, only emissive copies after the first emissive one go: a ray through a hole of one copy goes on to the
-// other at the same distance, so together they are as solid as the solid one. Keeps file order. Returns the
-// emissive and the other triangles dropped.
-static std::pair<int, int> drop_repeated_triangles(mesh_data& mesh, const std::vector<vec3f>& pos,
-                                                   const std::vector<char>& emissive, const std::vector<char>& cutout) {
+// other at the same distance, so together they are as solid as the solid one. Keeps file order. Returns what it
+// dropped, emissive and other triangles apart.
+static std::array<repeat_drops, 2> drop_repeated_triangles(mesh_data& mesh, const std::vector<vec3f>& pos,
+                                                           const std::vector<char>& emissive,
+                                                           const std::vector<char>& cutout) {
   size_t n = mesh.tri_materials.size();
   auto is_emissive = [&](size_t t) { return emissive[size_t(mesh.tri_materials[t])] != 0; };
   auto has_cutout = [&](size_t t) { return cutout[size_t(mesh.tri_materials[t])] != 0; };
@@ -202,7 +209,7 @@ static std::pair<int, int> drop_repeated_triangles(mesh_data& mesh, const std::v
   std::sort(groups.begin(), groups.end());
   std::vector<char> drop(n, 0);
   std::vector<std::pair<corner_key, uint32_t>> keys;
-  std::pair<int, int> dropped{0, 0};
+  std::array<repeat_drops, 2> dropped{};  // [0]: emissive, [1]: the others
   for (size_t g = 0, e; g < n; g = e) {
     for (e = g + 1; e < n && groups[e].first == groups[g].first;) e++;
     if (e - g < 2) continue;
@@ -222,12 +229,14 @@ static std::pair<int, int> drop_repeated_triangles(mesh_data& mesh, const std::v
       for (size_t k = a; k < b; k++) holes = holes || has_cutout(keys[k].second);
       for (size_t k = a; k < b; k++)
         if (k != keep && (!holes || (is_emissive(keys[k].second) && is_emissive(keys[keep].second)))) {
-          drop[keys[k].second] = 1;
-          (is_emissive(keys[k].second) ? dropped.first : dropped.second)++;
+          const uint32_t t = keys[k].second;
+          drop[t] = 1;
+          repeat_drops& r = dropped[is_emissive(t) ? 0 : 1];
+          if (r.count++ == 0 || int(t) < r.first) r.first = int(t), r.kept = int(keys[keep].second);
         }
     }
   }
-  if (dropped.first + dropped.second == 0) return dropped;
+  if (dropped[0].count + dropped[1].count == 0) return dropped;
   size_t out = 0;
   for (size_t t = 0; t < n; t++) {
     if (drop[t]) continue;
@@ -258,19 +267,23 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   size_t next_corner = 0;
   int64_t untextured = 0;   // faces of a textured material with a corner without vt
   int untextured_material = invalid_id;  // the first such face's material
+  int untextured_line = 0, fan_line = 0;  // lines of the first such face, and of the first fan-triangulated one
+  std::vector<int> tri_face;               // face of each triangle kept, for the warnings' line numbers
   for (size_t face = 0; face < clean.face_sizes.size(); face++) {
     int n = clean.face_sizes[face];
     const obj_corner* c = &clean.corners[next_corner];
     next_corner += size_t(n);
     corner_pos.resize(size_t(n));
     for (int i = 0; i < n; i++) corner_pos[size_t(i)] = position(size_t(c[i].v));
+    const int fans_before = st.fan_fallbacks;
     triangulate_polygon(corner_pos, st, local);
+    if (st.fan_fallbacks > fans_before && fan_line == 0) fan_line = clean.face_lines[face];
     int material = clean.face_materials[face] >= 0 ? clean.face_materials[face] : default_material;
     if (material != default_material && (!clean.materials[size_t(material)].kd_map.empty() ||
                                          !clean.materials[size_t(material)].alpha_map.empty())) {
       bool missing = false;
       for (int i = 0; i < n; i++) missing = missing || c[i].vt < 0;
-      if (missing && untextured++ == 0) untextured_material = material;
+      if (missing && untextured++ == 0) untextured_material = material, untextured_line = clean.face_lines[face];
     }
     int kept = 0, flat = 0, unusable = 0;
     for (size_t t = 0; t < local.size(); t += 3) {
@@ -288,39 +301,46 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
         mesh.tri_texcoords.push_back(x->vt);
       }
       mesh.tri_materials.push_back(material);
+      tri_face.push_back(int(face));
       if (mesh.tri_materials.size() > size_t(INT_MAX / 3)) throw input_error(path, "too many triangles");
     }
     // A face with no triangle left has no area (its corners on one line or at fewer than 3 points, as written or
     // rounded to float): all n - 2 of its triangles count as degenerate, also those triangulation left out. A face
     // with area loses nothing with its flat triangles (between corners on one of its edges: T-junction points).
-    if (kept == 0) {
-      mesh.dropped_degenerate += n - 2;
-    } else {
-      mesh.dropped_degenerate += unusable;
-      mesh.dropped_flat += flat;
-    }
+    const int degenerate = kept == 0 ? n - 2 : unusable;
+    if (degenerate > 0 && mesh.dropped_degenerate == 0) mesh.first_degenerate_line = clean.face_lines[face];
+    mesh.dropped_degenerate += degenerate;
+    if (kept > 0) mesh.dropped_flat += flat;
   }
   std::vector<char> emissive(clean.materials.size() + 1, 0);  // the last: the default material
   for (size_t k = 0; k < clean.materials.size(); k++) emissive[k] = !is_black(clean.materials[k].material.ke);
   std::vector<char> cutout(clean.materials.size() + 1, 0);
   for (size_t k = 0; k < clean.materials.size(); k++) cutout[k] = !clean.materials[k].alpha_map.empty();
-  auto [repeated, copies] = drop_repeated_triangles(mesh, clean.positions, emissive, cutout);
-  if (repeated > 0)
-    stderr_text() << "warning: " << path << ": dropped " << repeated << " emissive triangle"
-                  << (repeated > 1 ? "s" : "")
-                  << " repeating an earlier one (same corners, same side), which would light the scene once per copy\n";
-  if (copies > 0)
-    stderr_text() << "warning: " << path << ": dropped " << copies << " triangle" << (copies > 1 ? "s" : "")
-                  << " repeating another (same corners, same side; an emissive one is kept first, else the first)\n";
+  const auto [repeated, copies] = drop_repeated_triangles(mesh, clean.positions, emissive, cutout);
+  // Where the first dropped repeat is written, and the copy it repeats (the same line for two triangles of a face).
+  auto repeat_lines = [&](const repeat_drops& r) {
+    const int a = clean.face_lines[size_t(tri_face[size_t(r.first)])];
+    const int b = clean.face_lines[size_t(tri_face[size_t(r.kept)])];
+    return "; the first at line " + std::to_string(a) + (a == b ? ", within its face" : ", repeating line " + std::to_string(b));
+  };
+  if (repeated.count > 0)
+    stderr_text() << "warning: " << path << ": dropped " << repeated.count << " emissive triangle"
+                  << (repeated.count > 1 ? "s" : "") << " repeating an earlier one (same corners, same side"
+                  << repeat_lines(repeated) << "), which would light the scene once per copy\n";
+  if (copies.count > 0)
+    stderr_text() << "warning: " << path << ": dropped " << copies.count << " triangle" << (copies.count > 1 ? "s" : "")
+                  << " repeating another (same corners, same side; an emissive one is kept first, else the first"
+                  << repeat_lines(copies) << ")\n";
   if (untextured > 0)
     stderr_text() << "warning: " << path << ": " << untextured << " face" << (untextured > 1 ? "s" : "")
-                  << " of a textured material (the first: \"" << clean.materials[size_t(untextured_material)].material.name
-                  << "\") " << (untextured > 1 ? "have" : "has") << " a corner without texture coordinates (vt): "
+                  << " of a textured material (the first: line " << untextured_line << ", \""
+                  << clean.materials[size_t(untextured_material)].material.name << "\") "
+                  << (untextured > 1 ? "have" : "has") << " a corner without texture coordinates (vt): "
                   << "texture coordinates (0, 0) are used there\n";
   if (st.fan_fallbacks > 0)
     stderr_text() << "warning: " << path << ": " << st.fan_fallbacks
                   << " polygon(s) that cross themselves, too complex to ear-clip in the time budget, were "
-                     "fan-triangulated\n";
+                     "fan-triangulated (the first at line " << fan_line << ")\n";
   if (mesh.tri_materials.empty())
     throw input_error(path,
                       "no triangles" + (mesh.dropped_degenerate > 0

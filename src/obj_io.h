@@ -50,6 +50,7 @@ struct mesh_data {
   std::vector<int> tri_materials; // 1 per triangle: index into materials
   std::vector<material_data> materials;
   std::vector<texture_data> textures;
+  int first_degenerate_line = 0;  // OBJ line of the first face that lost a triangle as degenerate (0: none)
   int dropped_degenerate = 0;     // triangles removed on load (degenerate_reason): n - 2 of each face without area
                                   // (corners on one line or at fewer than 3 points), and those float cannot square
   int dropped_flat = 0;           // zero-area triangles between corners on one line of a face with area (T-junction

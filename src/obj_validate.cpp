@@ -664,6 +664,7 @@ obj_clean_data validate_obj(const std::string& path) {
       for (size_t i = 1; i <= args; i++) d.corners.push_back(check_corner(t[i], d, pos));
       d.face_sizes.push_back(int(args));
       d.face_materials.push_back(current);
+      d.face_lines.push_back(int(std::min<size_t>(lines.line, INT_MAX)));
     } else if (k == "usemtl") {
       if (commented) tokenize(line, pos, named, true);
       else named = t;

@@ -42,6 +42,7 @@ struct obj_clean_data {
   std::vector<mtl_material_data> materials;  // used materials; k = order of first usemtl in the OBJ
   std::vector<int> face_sizes;               // corners of each face, in file order
   std::vector<int> face_materials;           // k of each face, or invalid_id before any usemtl
+  std::vector<int> face_lines;               // line of each face's f statement (at most INT_MAX), for warnings
   std::vector<obj_corner> corners;           // the faces' corners, face after face
   // v, vn and vt values as correctly rounded floats (strtof, locale "C").
   std::vector<vec3f> positions, normals;

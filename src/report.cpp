@@ -87,11 +87,10 @@ std::string render_summary(const render_result& r, const std::vector<std::string
   return s;
 }
 
-void report_dropped_triangles(const std::string& mesh_path, int dropped) {
+void report_dropped_triangles(const std::string& mesh_path, int dropped, int first_line) {
   if (dropped > 0)
-    std::fprintf(stderr,
-                 "%s: dropped %d degenerate triangle%s (%s)\n", mesh_path.c_str(), dropped, dropped == 1 ? "" : "s",
-                 degenerate_reason);
+    std::fprintf(stderr, "%s: dropped %d degenerate triangle%s, the first of the face at line %d (%s)\n",
+                 mesh_path.c_str(), dropped, dropped == 1 ? "" : "s", first_line, degenerate_reason);
 }
 
 }  // namespace bl

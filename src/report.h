@@ -15,7 +15,8 @@ std::string render_summary(const render_result& r, const std::vector<std::string
 // Peak resident memory of this process so far (bytes; 0 when unknown).
 size_t peak_memory_bytes();
 
-// Tells stderr how many degenerate (zero-area) triangles the mesh at `mesh_path` lost on load (nothing when none).
-void report_dropped_triangles(const std::string& mesh_path, int dropped);
+// Tells stderr how many degenerate (zero-area) triangles the mesh at `mesh_path` lost on load, and the OBJ line of
+// the first face that lost one (nothing when none).
+void report_dropped_triangles(const std::string& mesh_path, int dropped, int first_line);
 
 }  // namespace bl

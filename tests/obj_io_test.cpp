@@ -450,8 +450,19 @@ TEST_CASE("a triangle repeating another is dropped, the first emissive one kept"
                                     "usemtl lamp\nf 1 2 3\nf 2 3 1\nf 5 2 3\nf 3 2 1\n"  // same, rotated, copy, reversed
                                     "f 6 2 3\n"
                                     "usemtl wall\nf 1 2 3\nf 1 2 3\n");                  // non-emissive repeats
-  mesh_data m = load_obj(obj);
+  mesh_data m;
+  const std::string said = load_warnings(obj, &m);
   check_invariants(m);
+  // The warnings name where the first dropped copy is written and the line it repeats (lamp: f 2 3 1 at line 10 of
+  // the lamp at line 9; walls: f 1 2 3 at line 15, also of line 9).
+  CHECK_THAT(said, Catch::Contains("dropped 3 emissive triangles repeating an earlier one (same corners, same side; "
+                                   "the first at line 10, repeating line 9)"));
+  CHECK_THAT(said, Catch::Contains("dropped 2 triangles repeating another (same corners, same side; an emissive one is "
+                                   "kept first, else the first; the first at line 15, repeating line 9)"));
+  // A polygon that goes round twice repeats its own triangles.
+  CHECK_THAT(load_warnings(dir.write("twice.obj", std::string(square_vertices) + "f 1 2 3 4 1 2 3 4\n")),
+             Catch::Contains("dropped 2 triangles repeating another (same corners, same side; an emissive one is kept "
+                             "first, else the first; the first at line 5, within its face)"));
   // Kept: the first lamp triangle and its reversed twin (the other side emits); the walls repeat the lamp.
   REQUIRE(triangle_count(m) == 2);
   CHECK(m.materials[size_t(m.tri_materials[0])].name == "lamp");
@@ -785,6 +796,8 @@ TEST_CASE("degenerate triangles are dropped and counted", "[obj]") {
   check_invariants(m);
   CHECK(triangle_count(m) == 3);
   CHECK(m.dropped_degenerate == 3);
+  CHECK(m.first_degenerate_line == 8);  // f 1 2 5 (the warning names it)
+  CHECK(load_obj(dir.write("ok.obj", std::string(square_vertices) + "f 1 2 3\n")).first_degenerate_line == 0);
 }
 
 TEST_CASE("faces without area are counted as degenerate, whatever their corner count", "[obj]") {
@@ -1489,7 +1502,7 @@ TEST_CASE("texture options that are not applied, and textured faces without vt, 
   INFO(warnings);
   CHECK_THAT(warnings, Catch::Contains("lib.mtl: texture options that are not applied (the texture is used without "
                                        "them): -mm (line 4), -cc (line 4), -blendv (line 5), -t (line 5)\n"));
-  CHECK_THAT(warnings, Catch::Contains("t.obj: 2 faces of a textured material (the first: \"b\") have a corner without "
+  CHECK_THAT(warnings, Catch::Contains("t.obj: 2 faces of a textured material (the first: line 10, \"b\") have a corner without "
                                        "texture coordinates (vt)"));
   // Defaults written out (as exporters do) and options that change nothing of a 2D texture: no warning.
   auto quiet = dir.write("q.obj", "mtllib lib.mtl\n" + std::string(square_vertices) + "vt 0 0\nusemtl a\nf 1/1 2/1 3/1\n");
