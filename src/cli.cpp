@@ -258,12 +258,10 @@ std::string frames_were(int a, int b) {
                 : "frames " + std::to_string(a) + " to " + std::to_string(b) + " were";
 }
 
-int run_render(const render_options& o) {
-  install_interrupt_handlers();  // (a signal while the scene loads ends the command at once)
-  sampler_kind kind;
-  if (!parse_sampler_kind(o.sampler, kind))
-    throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
-  const bool animated = o.frames > 0;  // --frames given: names are frame patterns (even for one frame)
+// The outputs of a render (-o as given, else SCENE.exr or, with --frames, SCENE_%04d.exr), after the checks of
+// the names of its files that need no scene: image formats, a log named like an image or scene, frame patterns.
+std::vector<std::string> checked_output_names(const render_options& o) {
+  const bool animated = o.frames > 0;
   std::vector<std::string> outputs = o.outputs;
   if (outputs.empty()) {
     // SCENE.exr in the working directory ("dir/" names dir: the scene load then says what is wrong with it).
@@ -300,6 +298,122 @@ int run_render(const render_options& o) {
         std::fprintf(stderr, "bayeslight: warning: -o %s is a frame pattern, but without --frames the render is one "
                      "image, written under that name as it stands\n", out.c_str());
   }
+  return outputs;
+}
+
+// Restores the checkpoint --resume names (its bytes in resume_bytes, released once decoded) into r and s, and says
+// what the render continues and adds; refuses a --spp below the saved one.
+void resume_render(const render_options& o, const render_params& params, const std::vector<std::string>& outputs,
+                   const render_fingerprint_data& fingerprint, const std::vector<uint64_t>& reference_keys,
+                   std::string& resume_bytes, render_result& r, light_sampler& s) {
+  const bool animated = o.frames > 0;
+  uint64_t measured = decode_checkpoint(resume_bytes, o.resume, fingerprint, params, r, s);
+  // Decoded: the file's bytes (the size of the sampler's state, 100 MB and more) were held for the whole render
+  // (a review: 343 MB against 222 MB resident).
+  std::string().swap(resume_bytes);
+  const uint64_t reference_key = reference_keys[size_t(r.frame)];
+  // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
+  if (params.time_budget <= 0 && r.spp > params.spp)
+    throw usage_error((o.spp > 0 ? "--spp " + std::to_string(params.spp)
+                                 : "the scene's render.spp (" + std::to_string(params.spp) + ")") +
+                      " is below the " + std::to_string(r.spp) + " spp already in " + o.resume + ": give --spp " +
+                      std::to_string(r.spp) + " or more, or --time");
+  // An animation's checkpoint of frame k: frames 0 to k - 1 were written by the render that saved it (they are not
+  // rendered again: frame k needs what they learned, and their state is gone).
+  std::string missing;
+  int count = 0;
+  for (int f = 0; f < r.frame; f++)
+    for (const std::string& out : outputs) {
+      std::string file = frame_path(out, f, animated);
+      if (!fs::exists(file) && count++ == 0) missing = file;
+    }
+  // What the render continues, and what it adds: its spp, seconds and --time budget count the checkpoint's (an
+  // animation's: those of the frame under way).
+  const bool budget_spent = params.time_budget > 0 && r.seconds >= params.time_budget;
+  if (count > 0 || !o.quiet) {
+    const std::string none = animated ? "frame " + std::to_string(r.frame) + " adds no pass" : "no pass is added";
+    char at[160], budget[160] = "";
+    if (animated)
+      std::snprintf(at, sizeof at, "the animation at frame %d of %d, %d spp into it (%d pass%s, %.3g s%s)", r.frame,
+                    params.frames, r.spp, r.passes, r.passes == 1 ? "" : "es", r.seconds,
+                    r.frame > 0 ? ("; " + frames_were(0, r.frame - 1) + " rendered before").c_str() : "");
+    else
+      std::snprintf(at, sizeof at, "at %d spp (%d pass%s, %.3g s rendered before)", r.spp, r.passes,
+                    r.passes == 1 ? "" : "es", r.seconds);
+    if (budget_spent)
+      std::snprintf(budget, sizeof budget, "; --time %g counts them and is spent: %s", params.time_budget,
+                    none.c_str());
+    else if (params.time_budget > 0)
+      std::snprintf(budget, sizeof budget, "; --time %g counts them: %.3g s left", params.time_budget,
+                    params.time_budget - r.seconds);
+    else if (params.spp == r.spp)
+      std::snprintf(budget, sizeof budget, "; --spp %d: %s", params.spp, none.c_str());
+    std::fprintf(stderr, "%s: resuming %s%s%s\n", o.resume.c_str(), at, budget,
+                 count == 0 ? ""
+                            : ("; warning: " + missing +
+                               (count > 1 ? " and " + std::to_string(count - 1) + " more of those frames' files are"
+                                          : " is") +
+                               " missing (a frame cannot be rendered alone: render the animation again for it)")
+                                  .c_str());
+  }
+  // The log is one error curve against one reference: rows measured against another one (or none) keep their
+  // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
+  if (measured != reference_key && !r.log.empty()) {
+    for (pass_record& p : r.log) p.has_error = false;
+    if (!o.log.empty())  // (said where a log is written)
+      std::fprintf(stderr, "%s: warning: its %d passes were %s; their rows of the log have no error values\n",
+                   o.resume.c_str(), r.passes,
+                   measured == 0        ? "rendered without --reference"
+                   : reference_key == 0 ? "measured against a reference, and this render has none"
+                                        : "measured against another reference");
+  }
+  // An adaptive sampler's passes after a truncated one learn from other sample counts (and weigh theirs
+  // otherwise) than one render's: still a correct image, but not the bytes the README promises at pass ends.
+  // Every pass of the saved render counts (a checkpoint of 10 spp reached through one of 9 is off schedule too).
+  int off = 0;
+  for (const pass_record& p : r.log)
+    if (!ends_scheduled_pass(p.spp, int64_t(r.width) * r.height)) {
+      off = p.spp;
+      break;
+    }
+  if (sampler_adapts(s) && off > 0 && (params.time_budget > 0 ? !budget_spent : params.spp > r.spp))
+    std::fprintf(stderr,
+                 "%s: warning: its pass ending at %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 "
+                 "... do): the continued image is correct, but not bit-identical to one render of the final spp\n",
+                 o.resume.c_str(), off);
+}
+
+// Says how an interrupted render ended (interrupted: in a pass, else after one; last_frame and last_passes: the last
+// frame whose outputs were written, and its passes; checkpoint_ok: no checkpoint failed to be written) and how to
+// go on; returns the exit status, 128 + signal.
+int report_interruption(const render_options& o, int frames, bool interrupted, int last_frame, int last_passes,
+                        bool checkpoint_ok) {
+  int sig = interrupt_signal();
+  const std::string rest = frames_were(last_frame + 1, frames - 1);  // (the frames after last_frame)
+  if (interrupted && frames > 1)  // (in an animation's frame: say what is left, and how to go on)
+    std::fprintf(stderr, "bayeslight: the animation stopped in frame %d of %d%s%s\n", last_frame, frames,
+                 last_frame + 1 < frames ? ("; " + rest + " not rendered").c_str() : "",
+                 o.checkpoint.empty() ? "" : ("; --resume " + o.checkpoint + " continues it").c_str());
+  else if (!interrupted && last_frame + 1 < frames)  // (between an animation's frames)
+    std::fprintf(stderr, "bayeslight: interrupted (%s) after frame %d; %s not rendered%s\n", signal_name(sig),
+                 last_frame, rest.c_str(),
+                 o.checkpoint.empty() ? "" : ("; --resume " + o.checkpoint + " renders them").c_str());
+  else if (!interrupted)
+    std::fprintf(stderr, "bayeslight: interrupted (%s) after the last pass; every output was written\n",
+                 signal_name(sig));
+  else if (!o.checkpoint.empty() && checkpoint_ok && last_passes > 0)  // (a still render)
+    std::fprintf(stderr, "bayeslight: %s holds the render; --resume %s continues it\n", o.checkpoint.c_str(),
+                 o.checkpoint.c_str());
+  return 128 + (sig != 0 ? sig : SIGINT);
+}
+
+int run_render(const render_options& o) {
+  install_interrupt_handlers();  // (a signal while the scene loads ends the command at once)
+  sampler_kind kind;
+  if (!parse_sampler_kind(o.sampler, kind))
+    throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
+  const bool animated = o.frames > 0;  // --frames given: names are frame patterns (even for one frame)
+  const std::vector<std::string> outputs = checked_output_names(o);
   warn_unused_options(o, {kind});
   // Every frame's files (a folder that exists for frame 0 only would fail them after their renders).
   for (int f = 0; f < std::max(1, o.frames); f++) {
@@ -366,81 +480,7 @@ int run_render(const render_options& o) {
     params.restore = [&](render_result& r, light_sampler& s) {
       if (setup_signal) std::raise(SIGINT);
       if (o.resume.empty()) return;
-      uint64_t measured = decode_checkpoint(resume_bytes, o.resume, fingerprint, params, r, s);
-      // Decoded: the file's bytes (the size of the sampler's state, 100 MB and more) were held for the whole render
-      // (a review: 343 MB against 222 MB resident).
-      std::string().swap(resume_bytes);
-      const uint64_t reference_key = reference_keys[size_t(r.frame)];
-      // Samples cannot be taken back out of a checkpoint: a smaller --spp would silently write the larger image.
-      if (params.time_budget <= 0 && r.spp > params.spp)
-        throw usage_error((o.spp > 0 ? "--spp " + std::to_string(params.spp)
-                                     : "the scene's render.spp (" + std::to_string(params.spp) + ")") +
-                          " is below the " + std::to_string(r.spp) + " spp already in " + o.resume + ": give --spp " +
-                          std::to_string(r.spp) + " or more, or --time");
-      // An animation's checkpoint of frame k: frames 0 to k - 1 were written by the render that saved it (they are not
-      // rendered again: frame k needs what they learned, and their state is gone).
-      std::string missing;
-      int count = 0;
-      for (int f = 0; f < r.frame; f++)
-        for (const std::string& out : outputs) {
-          std::string file = frame_path(out, f, animated);
-          if (!fs::exists(file) && count++ == 0) missing = file;
-        }
-      // What the render continues, and what it adds: its spp, seconds and --time budget count the checkpoint's (an
-      // animation's: those of the frame under way).
-      const bool budget_spent = params.time_budget > 0 && r.seconds >= params.time_budget;
-      if (count > 0 || !o.quiet) {
-        const std::string none = animated ? "frame " + std::to_string(r.frame) + " adds no pass" : "no pass is added";
-        char at[160], budget[160] = "";
-        if (animated)
-          std::snprintf(at, sizeof at, "the animation at frame %d of %d, %d spp into it (%d pass%s, %.3g s%s)", r.frame,
-                        params.frames, r.spp, r.passes, r.passes == 1 ? "" : "es", r.seconds,
-                        r.frame > 0 ? ("; " + frames_were(0, r.frame - 1) + " rendered before").c_str() : "");
-        else
-          std::snprintf(at, sizeof at, "at %d spp (%d pass%s, %.3g s rendered before)", r.spp, r.passes,
-                        r.passes == 1 ? "" : "es", r.seconds);
-        if (budget_spent)
-          std::snprintf(budget, sizeof budget, "; --time %g counts them and is spent: %s", params.time_budget,
-                        none.c_str());
-        else if (params.time_budget > 0)
-          std::snprintf(budget, sizeof budget, "; --time %g counts them: %.3g s left", params.time_budget,
-                        params.time_budget - r.seconds);
-        else if (params.spp == r.spp)
-          std::snprintf(budget, sizeof budget, "; --spp %d: %s", params.spp, none.c_str());
-        std::fprintf(stderr, "%s: resuming %s%s%s\n", o.resume.c_str(), at, budget,
-                     count == 0 ? ""
-                                : ("; warning: " + missing +
-                                   (count > 1 ? " and " + std::to_string(count - 1) + " more of those frames' files are"
-                                              : " is") +
-                                   " missing (a frame cannot be rendered alone: render the animation again for it)")
-                                      .c_str());
-      }
-      // The log is one error curve against one reference: rows measured against another one (or none) keep their
-      // pass, spp and time but lose their errors (before, the relMSE column jumped at the resumed pass unexplained).
-      if (measured != reference_key && !r.log.empty()) {
-        for (pass_record& p : r.log) p.has_error = false;
-        if (!o.log.empty())  // (said where a log is written)
-          std::fprintf(stderr,
-                     "%s: warning: its %d passes were %s; their rows of the log have no error values\n",
-                     o.resume.c_str(), r.passes,
-                     measured == 0        ? "rendered without --reference"
-                     : reference_key == 0 ? "measured against a reference, and this render has none"
-                                          : "measured against another reference");
-      }
-      // An adaptive sampler's passes after a truncated one learn from other sample counts (and weigh theirs
-      // otherwise) than one render's: still a correct image, but not the bytes the README promises at pass ends.
-      // Every pass of the saved render counts (a checkpoint of 10 spp reached through one of 9 is off schedule too).
-      int off = 0;
-      for (const pass_record& p : r.log)
-        if (!ends_scheduled_pass(p.spp, int64_t(r.width) * r.height)) {
-          off = p.spp;
-          break;
-        }
-      if (sampler_adapts(s) && off > 0 && (params.time_budget > 0 ? !budget_spent : params.spp > r.spp))
-        std::fprintf(stderr,
-                     "%s: warning: its pass ending at %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 "
-                     "... do): the continued image is correct, but not bit-identical to one render of the final spp\n",
-                     o.resume.c_str(), off);
+      resume_render(o, params, outputs, fingerprint, reference_keys, resume_bytes, r, s);
     };
   auto last_write = std::chrono::steady_clock::now();
   // A checkpoint that cannot be written (a full disk) is reported and the render goes on: its image is still
@@ -510,25 +550,8 @@ int run_render(const render_options& o) {
   });
   failures.rethrow();  // (main exits 128 + signal when a signal came, else 1)
   // A signal that came after the last pass (while the outputs were written) still ends the run as interrupted.
-  if (interrupted || interrupt_signal() != 0) {
-    int sig = interrupt_signal();
-    const std::string rest = frames_were(last_frame + 1, params.frames - 1);  // (the frames after last_frame)
-    if (interrupted && params.frames > 1)  // (in an animation's frame: say what is left, and how to go on)
-      std::fprintf(stderr, "bayeslight: the animation stopped in frame %d of %d%s%s\n", last_frame, params.frames,
-                   last_frame + 1 < params.frames ? ("; " + rest + " not rendered").c_str() : "",
-                   o.checkpoint.empty() ? "" : ("; --resume " + o.checkpoint + " continues it").c_str());
-    else if (!interrupted && last_frame + 1 < params.frames)  // (between an animation's frames)
-      std::fprintf(stderr, "bayeslight: interrupted (%s) after frame %d; %s not rendered%s\n", signal_name(sig),
-                   last_frame, rest.c_str(),
-                   o.checkpoint.empty() ? "" : ("; --resume " + o.checkpoint + " renders them").c_str());
-    else if (!interrupted)
-      std::fprintf(stderr, "bayeslight: interrupted (%s) after the last pass; every output was written\n",
-                   signal_name(sig));
-    else if (!o.checkpoint.empty() && checkpoint_failure.empty() && last_passes > 0)  // (a still render)
-      std::fprintf(stderr, "bayeslight: %s holds the render; --resume %s continues it\n", o.checkpoint.c_str(),
-                   o.checkpoint.c_str());
-    return 128 + (sig != 0 ? sig : SIGINT);
-  }
+  if (interrupted || interrupt_signal() != 0)
+    return report_interruption(o, params.frames, interrupted, last_frame, last_passes, checkpoint_failure.empty());
   if (!checkpoint_failure.empty()) throw output_error(checkpoint_failure);  // (the image is written)
   return exit_ok;
 }
