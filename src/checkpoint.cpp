@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <type_traits>
 
 namespace bl {
@@ -563,6 +565,14 @@ void write_checkpoint(const std::string& path, const render_fingerprint_data& fi
     const uint64_t checksum = sum.finish();
     sink(reinterpret_cast<const char*>(&checksum), sizeof checksum);
   });
+}
+
+bool holds_checkpoint(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;  // (opening a FIFO to read would wait for a writer)
+  std::ifstream f(path, std::ios::binary);
+  char head[sizeof magic];
+  return f.read(head, sizeof head) && std::memcmp(head, magic, sizeof magic) == 0;
 }
 
 uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,

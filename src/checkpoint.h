@@ -52,6 +52,10 @@ uint64_t reference_hash(const image_data* reference);
 // `frames`: the render's (render_params::frames); an animation's checkpoint also holds result.frame.
 void write_checkpoint(const std::string& path, const render_fingerprint_data& fingerprint, uint64_t reference,
                       const render_result& result, const light_sampler& sampler, int frames);
+// Whether the regular file at path starts as a checkpoint does (false where it cannot be read): a render given it as
+// --checkpoint without --resume would replace a saved render.
+bool holds_checkpoint(const std::string& path);
+
 // Restores a state written by write_checkpoint into a freshly built sampler of the same kind and the result;
 // throws input_error naming `path` when the data are malformed or were written for another scene/options (naming
 // the fingerprint's parts that differ).

@@ -38,6 +38,7 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 namespace bl {
 
@@ -408,7 +409,7 @@ int report_interruption(const render_options& o, int frames, bool interrupted, i
 }
 
 int run_render(const render_options& o) {
-  install_interrupt_handlers();  // (a signal while the scene loads ends the command at once)
+  install_interrupt_handlers(true, !o.resume.empty());  // (a first signal from here on: go on to write an image)
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
@@ -421,6 +422,10 @@ int run_render(const render_options& o) {
     if (!o.log.empty()) check_output_path(frame_path(o.log, f, animated));
   }
   if (!o.checkpoint.empty()) check_output_path(o.checkpoint);
+  // (A render saved there is lost at this one's first checkpoint: a forgotten --resume, or a second render's slip.)
+  if (!o.checkpoint.empty() && o.resume.empty() && holds_checkpoint(o.checkpoint))
+    std::fprintf(stderr, "bayeslight: warning: %s holds a saved render, which this render's checkpoints replace "
+                         "(--resume %s continues that render instead)\n", o.checkpoint.c_str(), o.checkpoint.c_str());
   std::string resume_bytes;
   if (!o.resume.empty()) resume_bytes = read_file(o.resume);
 
@@ -475,10 +480,14 @@ int run_render(const render_options& o) {
   std::vector<uint64_t> reference_keys;
   for (int f = 0; f < params.frames; f++)
     reference_keys.push_back(reference_hash(references.empty() ? nullptr : &references[size_t(f)]));
-  const bool setup_signal = o.stop_after_passes == 0;  // (testing: the render's set-up calls restore)
-  if (setup_signal || !o.resume.empty())
+  // (testing: the render's set-up calls restore)
+  const int setup_signals = o.stop_after_passes == 0 ? 1 : o.signals_in_setup;
+  if (setup_signals != 0 || !o.resume.empty())
     params.restore = [&](render_result& r, light_sampler& s) {
-      if (setup_signal) std::raise(SIGINT);
+      for (int k = 0; k < std::abs(setup_signals); k++) {
+        if (k > 0 && setup_signals < 0) std::this_thread::sleep_for(std::chrono::milliseconds(600));
+        std::raise(SIGINT);
+      }
       if (o.resume.empty()) return;
       resume_render(o, params, outputs, fingerprint, reference_keys, resume_bytes, r, s);
     };

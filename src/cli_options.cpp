@@ -188,6 +188,9 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--signals-in-first-pass", o.signals_in_first_pass,
                 "testing: raise SIGINT N times once the first pass's first row is done (-N: 0.6 s apart)")
       ->group("");
+  r->add_option("--signals-in-setup", o.signals_in_setup,
+                "testing: raise SIGINT N times while the render sets up (-N: 0.6 s apart)")
+      ->group("");
   r->add_option("--signal-in-frame", o.signal_frame, "testing: raise SIGINT once during frame K's first pass (K > 0)")
       ->group("");
   r->add_option("--kill-after-passes", o.kill_after_passes, "testing: raise SIGKILL after the checkpoint of pass N, counted over frames")

@@ -49,6 +49,7 @@ struct render_options {
   bool signal_after_last_pass = false;  // testing aid: raise SIGINT once the last pass is done, before the outputs
   int kill_after_passes = 0;  // testing aid: raise SIGKILL right after the checkpoint of this pass
   int signals_in_first_pass = 0;  // testing aid: raise SIGINT this many times once the first pass's first row is done
+  int signals_in_setup = 0;       // testing aid: raise SIGINT this many times in the render's set-up (-N: 0.6 s apart)
   int signal_frame = -1;          // testing aid: raise SIGINT once during this frame's first pass (frames > 0)
   std::vector<std::pair<std::string, std::string>> given;  // options given on the command line: (name, help group)
 };

@@ -28,10 +28,17 @@ namespace {
 std::atomic<int> g_signal{0};
 std::atomic<int> g_signal_count{0};  // signals received (an output's wait ends on a new one)
 std::atomic<bool> g_first_pass{false};  // a render's first pass that a first signal lets finish is running
+// `render` (install_interrupt_handlers(true)): a first signal before the render's first pass begins lets the command
+// go on to render that pass and write its image (g_early_signal notes one); a second one ends it at once.
+std::atomic<bool> g_finish_early{false};
+std::atomic<bool> g_early_signal{false};
+std::atomic<bool> g_resuming{false};      // ... and when it resumes a checkpoint, to write the image of its passes
+std::atomic<bool> g_passes_begun{false};  // the render's passes have begun (not an oracle's learning)
 // Where the command stands, for a signal: while setting up (loading the scene, phase_setup; then, in the first
 // render_frames, the light tree, the sampler's regions and a checkpoint's state, phase_render_setup) nothing has been
 // written yet, and a loader deep in a large file would notice a request only once it is done, so the handler ends
-// the process at once; afterwards it asks the render to stop after its pass.
+// the process at once (`render`: at a second signal; the first lets it go on to its first pass); afterwards it asks
+// the render to stop after its pass.
 enum phase : int { phase_none, phase_setup, phase_before_render, phase_render_setup, phase_render };
 std::atomic<int> g_phase{phase_none};
 
@@ -44,12 +51,20 @@ int64_t monotonic_ns() {
 std::atomic<int64_t> g_first_signal_ns{0}, g_last_signal_ns{0};
 
 // Writes a whole line to stderr from a signal handler: write(2) only, one write (a line another thread prints
-// stays whole).
-void signal_safe_line(const char* line) {
+// stays whole). The line is the pieces joined (at most 511 characters).
+void signal_safe_line(std::initializer_list<const char*> pieces) {
+  char line[512];
   size_t len = 0;
-  while (line[len]) len++;
+  for (const char* p : pieces)
+    for (; *p && len < sizeof line; p++) line[len++] = *p;
   ssize_t ignored = write(2, line, len);
   (void)ignored;
+}
+
+// Whether a second signal came, at least half a second after the first. (GNU timeout sends its signal twice, to the
+// process and to its group: two deliveries microseconds apart are one request.)
+bool second_request() {
+  return g_signal_count.load() >= 2 && g_last_signal_ns.load() - g_first_signal_ns.load() >= 500000000;
 }
 
 extern "C" void on_interrupt(int sig) {
@@ -59,19 +74,17 @@ extern "C" void on_interrupt(int sig) {
     int saved = errno;
     ~keep_errno() { errno = saved; }
   } keep;
-  const int which = sig == SIGTERM ? 1 : sig == SIGHUP ? 2 : 0;
-  int phase = g_phase.load();
-  if (phase == phase_setup || phase == phase_render_setup) {
+  static const char* const names[3] = {"SIGINT", "SIGTERM", "SIGHUP"};
+  const char* name = names[sig == SIGTERM ? 1 : sig == SIGHUP ? 2 : 0];
+  const int phase = g_phase.load();
+  const bool setting_up = phase == phase_setup || phase == phase_render_setup;
+  const char* where = phase == phase_setup          ? "while loading the scene"
+                      : phase == phase_render_setup ? "while setting up the render"
+                                                    : "before the first pass";
+  if (setting_up && !g_finish_early.load()) {
     // Async-signal-safe: write(2) and _exit(2) only. The message names the phase: loading the scene, or the render's
     // set-up (light tree, regions, a checkpoint's state), which takes seconds in a scene of many emitters.
-    static const char* const lines[2][3] = {
-        {"bayeslight: interrupted (SIGINT) while loading the scene; nothing written\n",
-         "bayeslight: interrupted (SIGTERM) while loading the scene; nothing written\n",
-         "bayeslight: interrupted (SIGHUP) while loading the scene; nothing written\n"},
-        {"bayeslight: interrupted (SIGINT) while setting up the render; nothing written\n",
-         "bayeslight: interrupted (SIGTERM) while setting up the render; nothing written\n",
-         "bayeslight: interrupted (SIGHUP) while setting up the render; nothing written\n"}};
-    signal_safe_line(lines[phase == phase_setup ? 0 : 1][which]);
+    signal_safe_line({"bayeslight: interrupted (", name, ") ", where, "; nothing written\n"});
     _exit(128 + sig);
   }
   const int64_t now = monotonic_ns();
@@ -80,25 +93,33 @@ extern "C" void on_interrupt(int sig) {
   for (int64_t last = g_last_signal_ns.load(); last < now && !g_last_signal_ns.compare_exchange_weak(last, now);) {
   }
   g_signal.store(sig);
-  if (g_signal_count.fetch_add(1) == 0 && g_first_pass.load()) {
-    static const char* const lines[3] = {
-        "bayeslight: interrupted (SIGINT) in the first pass: finishing it to write an image (interrupt again, "
-        "half a second or more later, to stop now, with none)\n",
-        "bayeslight: interrupted (SIGTERM) in the first pass: finishing it to write an image (interrupt again, "
-        "half a second or more later, to stop now, with none)\n",
-        "bayeslight: interrupted (SIGHUP) in the first pass: finishing it to write an image (interrupt again, "
-        "half a second or more later, to stop now, with none)\n"};
-    signal_safe_line(lines[which]);
+  const bool first_signal = g_signal_count.fetch_add(1) == 0;
+  if (g_finish_early.load() && !g_passes_begun.load()) {
+    // `render` before its first pass: the first signal lets it go on to that pass; a second one, while nothing can
+    // see it (loading, set-up, the time between), ends it here.
+    if (first_signal) {
+      g_early_signal.store(true);
+      signal_safe_line({"bayeslight: interrupted (", name, ") ", where,
+                        g_resuming.load() ? ": going on to write the image of the checkpoint's passes"
+                                          : ": going on to render a first pass and write its image",
+                        " (interrupt again, half a second or more later, to stop now, with none)\n"});
+    } else if (phase != phase_render && second_request()) {
+      signal_safe_line({"bayeslight: interrupted again (", name, ") ", where, "; nothing written\n"});
+      _exit(128 + sig);
+    }
+    return;
   }
+  if (first_signal && g_first_pass.load())
+    signal_safe_line({"bayeslight: interrupted (", name,
+                      ") in the first pass: finishing it to write an image (interrupt again, half a second or more "
+                      "later, to stop now, with none)\n"});
 }
 
-// Whether a pass must stop: on a signal; in a first pass that may finish (g_first_pass), on a second one that came
-// at least half a second after the first. (GNU timeout sends its signal twice, to the process and to its group: two
-// deliveries microseconds apart are one request.)
+// Whether a pass must stop: on a signal; in a first pass that may finish (g_first_pass), on a second request.
 bool stop_requested() {
   if (g_signal.load(std::memory_order_relaxed) == 0) return false;
   if (!g_first_pass.load(std::memory_order_relaxed)) return true;
-  return g_signal_count.load() >= 2 && g_last_signal_ns.load() - g_first_signal_ns.load() >= 500000000;
+  return second_request();
 }
 
 using clock_type = std::chrono::steady_clock;
@@ -264,7 +285,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     // before it (an interrupted oracle's learning, the buffers' preparation) stops the render here, as it stops later
     // passes.
     const bool first = params.finish_first_pass && pass == 0 && done == 0;
-    if (g_signal.load() != 0) {
+    // (`render`: a first signal before this pass, as the scene loaded or the render set up, lets it run too)
+    if (g_signal.load() != 0 && !(first && g_early_signal.load() && !second_request())) {
       result.interrupted = true;
       break;
     }
@@ -421,7 +443,8 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     bool active = false;
     setup_scope() {
       int expected = phase_before_render;
-      active = g_signal.load() == 0 && g_phase.compare_exchange_strong(expected, phase_render_setup);
+      active = (g_signal.load() == 0 || g_early_signal.load()) &&
+               g_phase.compare_exchange_strong(expected, phase_render_setup);
     }
     ~setup_scope() {
       if (active) g_phase.store(phase_render);
@@ -458,11 +481,19 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     lp.signals_in_first_pass = 0;
     render_result scratch;
     note.emplace(params.notes, "learning the model of --bayes-oracle " + std::to_string(lp.spp) + " spp ...");
+    const bool finish_early = g_finish_early.exchange(false);  // (a signal while it learns stops the render too)
     render_with(learn_in, *b, lp, scratch);
+    g_finish_early.store(finish_early);
     note.reset();
-    if (scratch.interrupted)
+    if (scratch.interrupted && g_early_signal.load())
+      std::fprintf(stderr, "bayeslight: no first pass after all: --bayes-oracle's learning was cut short, and a pass "
+                           "of a model not fully learned would not be this render's\n");
+    if (scratch.interrupted) {
       // Cut short: nothing of it is kept, so a checkpoint saves an empty model and a resumed render learns it anew.
+      // Nor does a first pass follow (its half-learned or empty model would differ from one render's).
       sampler = make_light_sampler(params.sampler, in, tree);
+      g_early_signal.store(false);
+    }
     else
       b->frozen = true;
   }
@@ -489,6 +520,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     // its light choices depended on their own outcomes (bayes 1 % dark from frame 1 on with a still sun, z -22).
     render_inputs frame_in = in;
     frame_in.seed = frame_seed(params.seed, frame);
+    g_passes_begun.store(true);  // (a signal from here on stops the render after its pass, or its first pass's end)
     std::visit([&](auto& s) { render_with(frame_in, s, fp, result, after_pass); }, sampler);
     if (params.on_pass) params.on_pass(result, sampler, true);
     result.sampler_bytes = sampler_memory_bytes(sampler);
@@ -526,7 +558,9 @@ image_data film_image(const render_result& r) {
   return img;
 }
 
-void install_interrupt_handlers() {
+void install_interrupt_handlers(bool finish_first_pass, bool resuming) {
+  g_finish_early.store(finish_first_pass);
+  g_resuming.store(resuming);
   g_phase.store(phase_setup);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
@@ -553,11 +587,13 @@ void reset_interrupt() {
   g_signal_count.store(0);
   g_first_signal_ns.store(0);
   g_last_signal_ns.store(0);
+  g_early_signal.store(false);
+  g_passes_begun.store(false);
 }
 int interrupted_before_render() {
   g_phase.store(phase_before_render);  // until the first render sets up, a signal asks it to stop after its pass
   int sig = g_signal.load();
-  if (sig == 0) return 0;
+  if (sig == 0 || g_early_signal.load()) return 0;  // (`render` goes on to its first pass)
   std::fprintf(stderr, "bayeslight: interrupted (%s) while loading the scene; nothing written\n", signal_name(sig));
   return 128 + sig;
 }

@@ -121,7 +121,10 @@ image_data film_image(const render_result& r);
 // signal ends the process at once with "interrupted (SIG...) while loading the scene; nothing written" and 128 +
 // signal; so it does again while the command's first render_frames sets up (light tree, regions, a checkpoint's
 // state), saying "while setting up the render"; otherwise a signal requests the render to stop after the current pass.
-void install_interrupt_handlers();
+// finish_first_pass (`render`, whose first pass finishes for a signal): a first signal before that pass lets the
+// command go on to render it and write its image (resuming: to write the image of the checkpoint's passes); a second
+// one, half a second or more later, ends it at once.
+void install_interrupt_handlers(bool finish_first_pass = false, bool resuming = false);
 int interrupt_signal();
 // How many SIGINT/SIGTERM the handlers have received so far.
 int interrupt_count();
@@ -130,7 +133,8 @@ const char* signal_name(int sig);
 // Clears a pending interrupt request (tests).
 void reset_interrupt();
 // Ends the set-up phase (see install_interrupt_handlers). A signal noted before it (not while setting up, which
-// exits at once) is reported as one during loading: the exit status 128 + signal; else 0.
+// exits at once) is reported as one during loading: the exit status 128 + signal; else (or when the render goes on
+// to its first pass) 0.
 int interrupted_before_render();
 
 }  // namespace bl

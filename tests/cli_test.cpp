@@ -1581,11 +1581,13 @@ TEST_CASE("resuming an adaptive render from a truncated pass warns that the byte
   CHECK(r.output.find("its pass ending at 9 spp did not end a scheduled pass") != std::string::npos);
 }
 
-TEST_CASE("a signal while the render sets up keeps the checkpoint and log already there", "[cli]") {
-  // A signal during the light tree and regions (seconds in a large scene) waited for them; the render then stopped
-  // before its first pass and wrote a checkpoint of 0 passes over the one given, and a log of its header alone (a
-  // review: 10 spp lost by a command that forgot --resume). The render's set-up now ends the command at once, as
-  // loading does. --stop-after-passes 0 raises SIGINT there; also while a checkpoint is read for --resume.
+TEST_CASE("a signal while the render sets up goes on to its first pass, and a second one stops it with nothing written",
+          "[cli]") {
+  // The set-up (light tree, regions: 0.8 s in the living room) ended the command at once with nothing written, while
+  // a signal a moment later, in the first pass, finished that pass and wrote its image: a check that interrupts a
+  // render early (SPEC: "finishes writing the image of the passes completed so far") could find no file. A first
+  // signal before the first pass now lets the render go on to it; a second one, half a second later, ends it there.
+  // --stop-after-passes 0 and --signals-in-setup raise SIGINT in the set-up, also while a checkpoint is read.
   for (const char* sampler : {"bayes", "bound", "uniform"}) {
     tiny_scene d;
     std::string ck = d.dir / "ck.bin", log = d.dir / "log.csv", out = d.dir / "a.pfm";
@@ -1593,17 +1595,60 @@ TEST_CASE("a signal while the render sets up keeps the checkpoint and log alread
                        " --log " + log;
     auto first = run_bayeslight(base + " --spp 4");
     REQUIRE(first.status == 0);
-    std::string ck_bytes = read_text(ck), log_bytes = read_text(log), img_bytes = read_text(out);
-    for (std::string extra : {std::string(), " --resume " + ck}) {
-      auto r = run_bayeslight(base + " --spp 8 --stop-after-passes 0" + extra);
-      INFO(sampler << extra << ": " << r.output);
-      CHECK(r.status == 130);
-      CHECK(r.output.find("interrupted (SIGINT) while setting up the render; nothing written") != std::string::npos);
-      CHECK(read_text(ck) == ck_bytes);
-      CHECK(read_text(log) == log_bytes);
-      CHECK(read_text(out) == img_bytes);
-    }
+    const std::string ck_bytes = read_text(ck), log_bytes = read_text(log), img_bytes = read_text(out);
+    // Resumed: the image, log and checkpoint of the saved passes are written again, the same bytes.
+    auto r = run_bayeslight(base + " --spp 8 --stop-after-passes 0 --resume " + ck);
+    INFO(sampler << ": " << r.output);
+    CHECK(r.status == 130);
+    CHECK(r.output.find("interrupted (SIGINT) while setting up the render: going on to write the image of the "
+                        "checkpoint's passes") != std::string::npos);
+    CHECK(read_text(ck) == ck_bytes);
+    CHECK(read_text(log) == log_bytes);
+    CHECK(read_text(out) == img_bytes);
+    // A new render: its first pass (1 spp) is rendered and written, with its log row and checkpoint, which resumes
+    // to the bytes of one render.
+    r = run_bayeslight(base + " --spp 8 --signals-in-setup 1");
+    INFO(r.output);
+    CHECK(r.status == 130);
+    CHECK(r.output.find("interrupted (SIGINT) while setting up the render: going on to render a first pass and "
+                        "write its image") != std::string::npos);
+    REQUIRE(run_bayeslight("render " + d.json + " --sampler " + sampler + " --quiet --spp 1 -o " +
+                           (d.dir / "one.pfm")).status == 0);
+    CHECK(read_text(out) == read_text(d.dir / "one.pfm"));
+    CHECK(read_text(log).find("\n" + std::string(sampler) + ",1,1,") != std::string::npos);
+    REQUIRE(run_bayeslight(base + " --spp 8 --resume " + ck).status == 0);
+    REQUIRE(run_bayeslight("render " + d.json + " --sampler " + sampler + " --quiet --spp 8 -o " +
+                           (d.dir / "eight.pfm")).status == 0);
+    CHECK(read_text(out) == read_text(d.dir / "eight.pfm"));
+    // A second signal 0.6 s after the first, still in the set-up: exit 130 at once, nothing written over the files.
+    const std::string ck8 = read_text(ck), log8 = read_text(log), img8 = read_text(out);
+    r = run_bayeslight(base + " --spp 16 --signals-in-setup -2");
+    INFO(r.output);
+    CHECK(r.status == 130);
+    CHECK(r.output.find("interrupted again (SIGINT) while setting up the render; nothing written") !=
+          std::string::npos);
+    CHECK(read_text(ck) == ck8);
+    CHECK(read_text(log) == log8);
+    CHECK(read_text(out) == img8);
   }
+}
+
+TEST_CASE("a --checkpoint over a saved render without --resume draws a warning naming the --resume", "[cli]") {
+  // A render that forgot --resume replaced the saved one at its first checkpoint without a word.
+  tiny_scene d;
+  const std::string ck = d.dir / "ck.bin", base = "render " + d.json + " --quiet --spp 2 -o " + (d.dir / "a.pfm");
+  const std::string warning = "warning: " + ck + " holds a saved render, which this render's checkpoints replace "
+                              "(--resume " + ck + " continues that render instead)";
+  write_text(ck, "not a checkpoint");  // (another file there: replaced as any output is, without a word)
+  auto r = run_bayeslight(base + " --checkpoint " + ck);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("warning") == std::string::npos);
+  r = run_bayeslight(base + " --checkpoint " + ck);
+  CHECK(r.status == 0);
+  CHECK(r.output.find(warning) != std::string::npos);
+  r = run_bayeslight(base + " --checkpoint " + ck + " --resume " + ck);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("warning") == std::string::npos);
 }
 
 TEST_CASE("a signal while the scene loads ends the render with exit 130 or 143, not by the signal", "[cli]") {
@@ -1633,6 +1678,8 @@ TEST_CASE("a signal while the scene loads ends the render with exit 130 or 143, 
     INFO("signal " << sig << ", wait status " << status);
     REQUIRE(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 128 + sig);
-    CHECK(!exists(out));
+    // (The render goes on to its first pass and writes its image, as for a signal in that pass.)
+    CHECK(exists(out));
+    std::filesystem::remove(out);
   }
 }
