@@ -409,7 +409,15 @@ int report_interruption(const render_options& o, int frames, bool interrupted, i
 }
 
 int run_render(const render_options& o) {
-  install_interrupt_handlers(true, !o.resume.empty());  // (a first signal from here on: go on to write an image)
+  // A render saved at --checkpoint that this one does not resume would be replaced by this one's first checkpoint:
+  // it is said, and a signal before this render's first pass ends (the user's answer to that) writes nothing.
+  std::error_code ec;
+  const bool resumes_it = !o.resume.empty() && fs::equivalent(o.resume, o.checkpoint, ec);
+  const bool replaces_saved = !o.checkpoint.empty() && !resumes_it && holds_checkpoint(o.checkpoint);
+  // A first signal from here on lets the render go on to write the image of a first pass (of the checkpoint's passes
+  // when resuming), except where that would replace a saved render, or follow --bayes-oracle's learning cut short
+  // (the set-up then ends at once, as before any learning).
+  install_interrupt_handlers(!replaces_saved && (o.bayes.oracle_spp == 0 || !o.resume.empty()), !o.resume.empty());
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");
@@ -423,15 +431,16 @@ int run_render(const render_options& o) {
   }
   if (!o.checkpoint.empty()) check_output_path(o.checkpoint);
   // (A render saved there is lost at this one's first checkpoint: a forgotten --resume, or a second render's slip.)
-  if (!o.checkpoint.empty() && o.resume.empty() && holds_checkpoint(o.checkpoint))
-    std::fprintf(stderr, "bayeslight: warning: %s holds a saved render, which this render's checkpoints replace "
-                         "(--resume %s continues that render instead)\n", o.checkpoint.c_str(), o.checkpoint.c_str());
+  if (replaces_saved)
+    std::fprintf(stderr, "bayeslight: warning: %s holds a saved render, which this render's first checkpoint "
+                         "replaces (--resume %s continues that render instead; interrupted before its first pass "
+                         "ends, this render writes nothing)\n", o.checkpoint.c_str(), o.checkpoint.c_str());
   std::string resume_bytes;
   if (!o.resume.empty()) resume_bytes = read_file(o.resume);
 
   scene_desc desc = load_scene_desc(o.scene);
   render_params params = resolve_params(o, desc, kind);
-  params.finish_first_pass = true;  // (an interrupted render has an image to write)
+  params.finish_first_pass = !replaces_saved;  // (an interrupted render has an image to write)
   params.signals_in_first_pass = o.signals_in_first_pass;
   params.signal_frame = o.signal_frame;
   warn_after_scene(o, params, {kind});

@@ -34,6 +34,7 @@ std::atomic<bool> g_finish_early{false};
 std::atomic<bool> g_early_signal{false};
 std::atomic<bool> g_resuming{false};      // ... and when it resumes a checkpoint, to write the image of its passes
 std::atomic<bool> g_passes_begun{false};  // the render's passes have begun (not an oracle's learning)
+std::atomic<bool> g_no_first_pass{false};  // --bayes-oracle's learning was cut short: no first pass may follow
 // Where the command stands, for a signal: while setting up (loading the scene, phase_setup; then, in the first
 // render_frames, the light tree, the sampler's regions and a checkpoint's state, phase_render_setup) nothing has been
 // written yet, and a loader deep in a large file would notice a request only once it is done, so the handler ends
@@ -92,13 +93,17 @@ extern "C" void on_interrupt(int sig) {
   g_first_signal_ns.compare_exchange_strong(unset, now);
   for (int64_t last = g_last_signal_ns.load(); last < now && !g_last_signal_ns.compare_exchange_weak(last, now);) {
   }
-  g_signal.store(sig);
+  // (The count and the early flag before the signal itself: a thread that sees the signal sees them. The first
+  // signal's number is kept: the exit status is that of the request the render acts on.)
   const bool first_signal = g_signal_count.fetch_add(1) == 0;
-  if (g_finish_early.load() && !g_passes_begun.load()) {
+  const bool early = g_finish_early.load() && !g_passes_begun.load();
+  if (early && first_signal) g_early_signal.store(true);
+  int none = 0;
+  g_signal.compare_exchange_strong(none, sig);
+  if (early) {
     // `render` before its first pass: the first signal lets it go on to that pass; a second one, while nothing can
     // see it (loading, set-up, the time between), ends it here.
     if (first_signal) {
-      g_early_signal.store(true);
       signal_safe_line({"bayeslight: interrupted (", name, ") ", where,
                         g_resuming.load() ? ": going on to write the image of the checkpoint's passes"
                                           : ": going on to render a first pass and write its image",
@@ -275,6 +280,11 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   progress.rows = h;
   preparing.reset();
   progress_bar bar(progress, params.progress);
+  // From here a signal is one in (or after) the render's passes; the first pass of frame 0 may finish for it.
+  if (params.begins_passes) {
+    g_first_pass.store(params.finish_first_pass && result.passes == 0 && result.spp == 0);
+    g_passes_begun.store(true);
+  }
 
   const int target = params.time_budget > 0 ? INT_MAX : params.spp;
   int done = result.spp;
@@ -286,7 +296,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     // passes.
     const bool first = params.finish_first_pass && pass == 0 && done == 0;
     // (`render`: a first signal before this pass, as the scene loaded or the render set up, lets it run too)
-    if (g_signal.load() != 0 && !(first && g_early_signal.load() && !second_request())) {
+    if (g_signal.load() != 0 && !(first && !g_no_first_pass.load() && !second_request())) {
+      g_first_pass.store(false);
       result.interrupted = true;
       break;
     }
@@ -478,6 +489,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     lp.progress = false;
     lp.notes = false;  // (its own note below says what it does)
     lp.finish_first_pass = false;  // (a signal ends the learning at once, and the render before its first pass)
+    lp.begins_passes = false;
     lp.signals_in_first_pass = 0;
     render_result scratch;
     note.emplace(params.notes, "learning the model of --bayes-oracle " + std::to_string(lp.spp) + " spp ...");
@@ -485,14 +497,11 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     render_with(learn_in, *b, lp, scratch);
     g_finish_early.store(finish_early);
     note.reset();
-    if (scratch.interrupted && g_early_signal.load())
-      std::fprintf(stderr, "bayeslight: no first pass after all: --bayes-oracle's learning was cut short, and a pass "
-                           "of a model not fully learned would not be this render's\n");
     if (scratch.interrupted) {
       // Cut short: nothing of it is kept, so a checkpoint saves an empty model and a resumed render learns it anew.
       // Nor does a first pass follow (its half-learned or empty model would differ from one render's).
       sampler = make_light_sampler(params.sampler, in, tree);
-      g_early_signal.store(false);
+      g_no_first_pass.store(true);
     }
     else
       b->frozen = true;
@@ -520,7 +529,6 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
     // its light choices depended on their own outcomes (bayes 1 % dark from frame 1 on with a still sun, z -22).
     render_inputs frame_in = in;
     frame_in.seed = frame_seed(params.seed, frame);
-    g_passes_begun.store(true);  // (a signal from here on stops the render after its pass, or its first pass's end)
     std::visit([&](auto& s) { render_with(frame_in, s, fp, result, after_pass); }, sampler);
     if (params.on_pass) params.on_pass(result, sampler, true);
     result.sampler_bytes = sampler_memory_bytes(sampler);
@@ -589,6 +597,7 @@ void reset_interrupt() {
   g_last_signal_ns.store(0);
   g_early_signal.store(false);
   g_passes_begun.store(false);
+  g_no_first_pass.store(false);
 }
 int interrupted_before_render() {
   g_phase.store(phase_before_render);  // until the first render sets up, a signal asks it to stop after its pass

@@ -45,6 +45,9 @@ struct render_params {
   // image to write, and the render then stops; a second one, half a second or more later, stops it at once. (The
   // render command; compare, profile and the oracle's learning stop at once.)
   bool finish_first_pass = false;
+  // The render's own passes (false: --bayes-oracle's learning): a signal from their start on is no longer one before
+  // the first pass (install_interrupt_handlers).
+  bool begins_passes = true;
   // Testing: raise SIGINT this many times once the first pass's first row is done (< 0: -N times, 0.6 s apart).
   int signals_in_first_pass = 0;
   int signal_frame = -1;  // testing: raise SIGINT once in this frame's first pass (after its first row; frames > 0)
