@@ -348,9 +348,12 @@ struct checkpoint_bytes {
   }
 };
 
+// A pass record: pass, spp, seconds, has_error, relmse, mse, maxabs.
+constexpr size_t pass_record_bytes = 4 + 4 + 8 + 1 + 3 * 8;
+
 // Offsets of the fields the test edits.
 struct checkpoint_fields {
-  size_t passes, film, film_weight, cut_nodes, pair_parent, pending, pending_slots, moments;
+  size_t passes, log, film, film_weight, cut_nodes, pair_parent, pending, pending_slots, pending_count, moments;
   size_t regions, regions_end;  // the region state: from its first column to the end of its pending table
   uint64_t parents = 0;  // entries of the pair_parent column
 };
@@ -360,7 +363,7 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   f.passes = c.value(4);
   c.value(4 + 4 + 8 + 6 * 8);  // spp, stratum base, seconds, counters
   uint64_t log = c.get<uint64_t>(c.value(8));
-  c.value(log * (4 + 4 + 8 + 1 + 3 * 8));
+  f.log = c.value(log * pass_record_bytes);
   f.film = c.column(8);
   f.film_weight = c.value(8);
   f.regions = c.pos;
@@ -372,7 +375,7 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   for (int k = 0; k < 4; k++) c.column(4);      // member_begin, pair_count, pair_node, pair_slot
   f.pending_slots = c.get<uint64_t>(c.pos);
   f.pending = c.column(16);                     // {key, id} slots
-  c.value(8);                                   // pending count
+  f.pending_count = c.value(8);
   f.regions_end = c.pos;
   if (bayes) f.moments = c.column(8);           // n0
   return f;
@@ -428,6 +431,34 @@ TEST_CASE("the checkpoint fingerprint sees every texture option of every materia
     }
 }
 
+TEST_CASE("the checkpoint fingerprint sees the camera, the sun and two_sided_emitters", "[checkpoint]") {
+  // Each changes the image: a checkpoint of one must not resume with another, and the refusal names the scene.
+  camera_params cam;
+  scene_data scene = build_scene(boxed_lamp_mesh(), cam, sun_params{}, false, 1.0f);
+  render_params p;
+  const render_fingerprint_data base = render_fingerprint(scene, p);
+  std::vector<std::pair<const char*, void (*)(scene_data&)>> changes = {
+      {"eye", [](scene_data& s) { s.camera.eye.x += 0.5f; }},
+      {"target", [](scene_data& s) { s.camera.target.y += 0.5f; }},
+      {"up", [](scene_data& s) { s.camera.up = {1, 0, 0}; }},
+      {"fov", [](scene_data& s) { s.camera.fov_y_deg += 1; }},
+      {"sun", [](scene_data& s) { s.sun.enabled = !s.sun.enabled; }},
+      {"sun direction", [](scene_data& s) { s.sun.direction = {1, 0, 0}; }},
+      {"sun irradiance", [](scene_data& s) { s.sun.irradiance.z += 1; }},
+      {"sun diameter", [](scene_data& s) { s.sun.angular_diameter_deg *= 2; }},
+      {"two_sided_emitters", [](scene_data& s) { s.two_sided_emitters = !s.two_sided_emitters; }}};
+  for (const auto& [name, change] : changes) {
+    scene_data changed = scene;
+    change(changed);
+    INFO(name);
+    const render_fingerprint_data f = render_fingerprint(changed, p);
+    CHECK(f.total != base.total);
+    CHECK(f.parts[fp_scene] != base.parts[fp_scene]);
+    for (int part = 0; part < fp_part_count; part++)
+      if (part != fp_scene) CHECK(f.parts[part] == base.parts[part]);
+  }
+}
+
 TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed", "[checkpoint]") {
   // Indices out of range crashed the resumed render, a full pending table or a pair whose parent has a parent made it
   // loop for ever, non-finite film values gave NaN pixels (and values beyond float's range infinite ones): each is an
@@ -461,6 +492,23 @@ TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed
     edit("film beyond float", [&](checkpoint_bytes& c) { c.put<double>(f.film, 1e300); });
     edit("film weight infinite", [&](checkpoint_bytes& c) { c.put<double>(f.film_weight, HUGE_VAL); });
     edit("passes", [&](checkpoint_bytes& c) { c.put<int>(f.passes, 2147483647); });
+    // A pass that adds no samples (the second pass's total as the first's): bound's passes weigh alike, so the film's
+    // weight, the last pass's total, still matches.
+    if (!bayes)
+      edit("pass adding no samples", [&](checkpoint_bytes& c) {
+        c.put<int>(f.log + pass_record_bytes + 4, c.get<int>(f.log + 4));
+      });
+    // More than half the pending table's slots in use, its count to match (a full one sent lookups round for ever).
+    edit("pending table over half full", [&](checkpoint_bytes& c) {
+      uint64_t used = c.get<uint64_t>(f.pending_count);
+      for (uint64_t k = 0; k < f.pending_slots && 2 * used <= f.pending_slots; k++)
+        if (c.get<uint64_t>(f.pending + 16 * k) == empty_region_key) {
+          c.put<uint64_t>(f.pending + 16 * k, (uint64_t(1) << 61) + k);  // (a cell no render point reaches)
+          used++;
+        }
+      REQUIRE(2 * used > f.pending_slots);
+      c.put<uint64_t>(f.pending_count, used);
+    });
     if (bayes) edit("statistics NaN", [&](checkpoint_bytes& c) { c.put<double>(f.moments, std::nan("")); });
     // No region at all (every column empty, the counts 0): the render looked up the root region, which every render
     // has, and crashed.

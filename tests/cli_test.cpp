@@ -84,6 +84,18 @@ TEST_CASE("lights too small for float precision where they are are warned about"
   CHECK(r.status == 0);
   CHECK(r.output.find("warning: the lights are so far from the origin for their size that rays leave surfaces by") !=
         std::string::npos);
+  // 1e4 from the origin rays leave surfaces by 0.01, a fifth of a 0.05-unit lamp (its triangles' area, 0.00125, is
+  // smaller than the offset, their side is not): no warning.
+  write_text(dir / "box.obj", "mtllib box.mtl\n"
+                              "v 9999 0 -1\nv 10001 0 -1\nv 10001 0 1\nv 9999 0 1\n"
+                              "v 9999.975 1 -0.025\nv 10000.025 1 -0.025\nv 10000.025 1 0.025\nv 9999.975 1 0.025\n"
+                              "usemtl floor\nf 1 4 3 2\nusemtl lamp\nf 5 6 7 8\n");
+  write_text(json, "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [10000, 0.5, 2], \"target\": [10000, 0, 0]},"
+                   " \"image\": {\"width\": 16, \"height\": 12}, \"render\": {\"spp\": 2, \"max_depth\": 2}}");
+  r = run_bayeslight("render " + json + " --quiet -o " + (dir / "a.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("so far from the origin") == std::string::npos);
 }
 
 TEST_CASE("an emitter lying on another surface or emitter is warned about, one just off it or its twin is not", "[cli]") {
@@ -408,6 +420,11 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
        "direction"},
       {"negsun.json", "{\"mesh\": \"box.obj\", \"sun\": {\"direction\": [0,1,0], \"irradiance\": [-1,1,1]}}",
        "irradiance"},
+      {"negsun_blue.json", "{\"mesh\": \"box.obj\", \"sun\": {\"direction\": [0,1,0], \"irradiance\": [1,1,-1]}}",
+       "negsun_blue.json:1: sun \"irradiance\" must not be negative"},
+      // Beyond 1e30 either way (a direction's -1e31 would normalise as well as its 1e31).
+      {"huge_up.json", "{\"mesh\": \"box.obj\", \"camera\": {\"up\": [0, -1e31, 0]}}",
+       "huge_up.json:1: \"up\" must be a finite number of magnitude at most 1e30"},
       {"fov.json", "{\"mesh\": \"box.obj\", \"camera\": {\"fov_y_deg\": 0}}", "fov_y_deg"},
       {"type.json", "{\"mesh\": \"box.obj\", \"render\": {\"spp\": \"many\"}}", "\"spp\""},
       {"nofile.json", "{\"mesh\": \"nothere.obj\"}", "nothere.obj"},

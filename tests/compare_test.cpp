@@ -9,6 +9,7 @@
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
+#include <stb_image.h>
 
 #include <array>
 #include <cctype>
@@ -518,6 +519,8 @@ TEST_CASE("relMSE at a time interpolates log-log between the passes around it", 
   CHECK(relmse_at_time(log, 9) == 0.25);                           // after the last: the last
   // A pass with no error at all (it matched the reference): linear, not the later pass's value.
   CHECK(relmse_at_time(log_of({{1, 0}, {3, 0.2}}), 2) == Approx(0.1));
+  CHECK(relmse_at_time(log_of({{1, 0}, {3, 0.2}}), 1.5) == Approx(0.05));  // (a quarter of the way: 0.05, not 0.15)
+  CHECK(relmse_at_time(log_of({{1, 0.2}, {3, 0}}), 1.5) == Approx(0.15));
 }
 
 TEST_CASE("at equal spp the first sampler reaches its own mean relMSE at its own mean time", "[compare]") {
@@ -542,6 +545,31 @@ TEST_CASE("at equal spp the first sampler reaches its own mean relMSE at its own
   REQUIRE(st.size() == 2);
   CHECK(st[0].time_to_target == Approx(2.0));
   CHECK(st[1].time_to_target == Approx(2.0));  // (its only point is below the target: reached at its first pass)
+}
+
+TEST_CASE("at equal spp the speed-up is the ratio of relMSE times seconds", "[compare]") {
+  // The second sampler: the same relMSE in half the time, twice the efficiency; the third: a quarter of the relMSE
+  // in twice the time, also twice.
+  compare_data d;
+  d.samplers.resize(3);
+  const double seconds[3] = {2, 1, 4}, relmse[3] = {0.1, 0.1, 0.025};
+  for (size_t i = 0; i < 3; i++) {
+    compare_run run;
+    run.spp = 4;
+    pass_record p;
+    p.pass = 1;
+    p.spp = 4;
+    p.seconds = seconds[i];
+    p.has_error = true;
+    p.error.relmse = relmse[i];
+    run.log.push_back(p);
+    d.samplers[i].runs.push_back(run);
+  }
+  std::vector<compare_stats> st = comparison_stats(d);
+  REQUIRE(st.size() == 3);
+  CHECK(st[0].speedup == Approx(1));
+  CHECK(st[1].speedup == Approx(2));
+  CHECK(st[2].speedup == Approx(2));
 }
 
 // A run of one pass per time in `times` (seconds), each with relMSE c / t.
@@ -616,6 +644,43 @@ TEST_CASE("an interrupted equal-time comparison compares the samplers where the 
   CHECK(comparison_summary(d, p).find("compares the samplers at 0.88 s") != std::string::npos);
   d.signal = 0;  // complete: at the budget
   CHECK(comparison_time(d) == 2);
+}
+
+TEST_CASE("an interrupted comparison whose shortest run ended with its first pass compares there", "[compare]") {
+  // The second sampler's only pass ends at 0.6 s, the comparison time: its error is known there, not later.
+  compare_data d;
+  d.samplers.resize(2);
+  d.equal_time = true;
+  d.time_budget = 2;
+  d.signal = 2;
+  d.samplers[0].runs.push_back(run_of({0.25, 0.5, 1.0, 2.1}, 0.1));
+  d.samplers[1].runs.push_back(run_of({0.6}, 0.1));
+  REQUIRE(comparison_time(d) == 0.6);
+  std::vector<compare_stats> st = comparison_stats(d);
+  REQUIRE(st.size() == 2);
+  CHECK(!st[0].before_first_pass);
+  CHECK(!st[1].before_first_pass);
+  CHECK(st[1].relmse == Approx(0.1 / 0.6));
+  CHECK(st[1].speedup == Approx(1).epsilon(1e-9));
+  compare_params p;
+  p.samplers = {sampler_kind::uniform, sampler_kind::bayes};
+  p.render.time_budget = 2;
+  CHECK(comparison_summary(d, p).find("ends before the first pass") == std::string::npos);
+}
+
+TEST_CASE("the image relMSE of an equal-time comparison is run 1's last pass", "[compare]") {
+  // `<sampler>.exr` is run 1's render: the column gives its error, whichever run ends last or is listed last.
+  compare_data d;
+  d.samplers.resize(1);
+  d.equal_time = true;
+  d.time_budget = 1;
+  compare_run second = run_of({0.4, 1.1}, 0.2), first = run_of({0.5, 1.2}, 0.1);
+  second.run = 2;
+  first.run = 1;
+  d.samplers[0].runs = {first, second};
+  CHECK(comparison_stats(d)[0].image_relmse == Approx(0.1 / 1.2));
+  d.samplers[0].runs = {second, first};
+  CHECK(comparison_stats(d)[0].image_relmse == Approx(0.1 / 1.2));
 }
 
 TEST_CASE("an equal-time comparison shorter than a first pass gives no speed-up against that sampler", "[compare]") {
@@ -697,4 +762,71 @@ TEST_CASE("the error ramp spans viridis over a fixed logarithmic range", "[compa
   CHECK(err[1] == Approx((0.5 + 0 + 1.0) / 3));
   std::string png = encode_error_png(x, r, error_image_params{});
   CHECK(png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0);
+}
+
+TEST_CASE("the error image maps min_error to max_error logarithmically onto the ramp", "[compare]") {
+  // Pixels of relative error min_error, the geometric mean of the range and max_error: the ramp's bottom, middle
+  // (stop 4 of 8) and top, for the default range and another one.
+  for (const error_image_params& params : {error_image_params{}, error_image_params{0.01f, 10.0f}}) {
+    const double lo = params.min_error, hi = params.max_error, e[3] = {lo, std::sqrt(lo * hi), hi};
+    image_data x, r;
+    x.width = r.width = 3;
+    x.height = r.height = 1;
+    r.pixels.assign(9, 1.0f);
+    for (double v : e)
+      for (int c = 0; c < 3; c++) x.pixels.push_back(float(1 + 1.1 * v));  // |x - r| / (|r| + 0.1) = v
+    std::string png = encode_error_png(x, r, params);
+    int w = 0, h = 0, n = 0;
+    unsigned char* px =
+        stbi_load_from_memory(reinterpret_cast<const unsigned char*>(png.data()), int(png.size()), &w, &h, &n, 3);
+    REQUIRE(px != nullptr);
+    CHECK(w == 3);
+    CHECK(h == 1);
+    const float t[3] = {0, 0.5f, 1};
+    for (int i = 0; i < 3; i++) {
+      const std::array<uint8_t, 3> want = viridis_srgb8(t[i]);
+      INFO("range " << lo << " to " << hi << ", error " << e[i]);
+      for (int c = 0; c < 3; c++) CHECK(std::abs(int(px[3 * i + c]) - int(want[size_t(c)])) <= 2);
+    }
+    stbi_image_free(px);
+  }
+}
+
+namespace {
+
+// The coordinates of the first <path>'s points ("M x y L x y ...") in an SVG document.
+std::vector<std::pair<double, double>> first_path_points(const std::string& svg) {
+  std::vector<std::pair<double, double>> points;
+  size_t at = svg.find("<path d=\"");
+  if (at == std::string::npos) return points;
+  std::string d = svg.substr(at + 9, svg.find('"', at + 9) - at - 9);
+  for (char& c : d)
+    if (c == 'M' || c == 'L') c = ' ';
+  std::istringstream in(d);
+  for (double x, y; in >> x >> y;) points.push_back({x, y});
+  return points;
+}
+
+}  // namespace
+
+TEST_CASE("the plot puts larger values higher up and data on one decade line on finite axes", "[compare]") {
+  loglog_plot_params p;
+  // Time to the right, relMSE falling: the second point is to the right of and below the first (SVG's y grows
+  // downward).
+  std::vector<std::pair<double, double>> pts = first_path_points(loglog_plot_svg({{"a", {0.1, 10}, {1, 0.01}}}, p));
+  REQUIRE(pts.size() == 2);
+  CHECK(pts[1].first > pts[0].first);
+  CHECK(pts[1].second > pts[0].second);
+  // Every point at exact powers of ten (one pass at 1 s of relMSE 0.01): each axis still spans a decade, and every
+  // coordinate is a number.
+  for (const plot_series& one : {plot_series{"one", {1}, {0.01}}, plot_series{"same", {1, 1}, {0.01, 0.01}}}) {
+    std::string svg = loglog_plot_svg({one}, p);
+    INFO(svg);
+    CHECK(xml_problem(svg) == "");
+    CHECK(svg.find("nan") == std::string::npos);
+    CHECK(svg.find("inf") == std::string::npos);
+    pts = first_path_points(svg);
+    REQUIRE(!pts.empty());
+    for (auto [x, y] : pts) CHECK((std::isfinite(x) && std::isfinite(y)));
+  }
 }

@@ -50,6 +50,17 @@ TEST_CASE("write_file_atomic writes and replaces files and leaves no temporary",
   CHECK(entries(dir.path.string()) == std::set<std::string>{"out.bin"});
 }
 
+TEST_CASE("write_file_atomic writes a file whose name is near the longest a name may be", "[file_io]") {
+  // 250 characters: its temporary, ".NAME.tmp.<pid>.<n>", would pass NAME_MAX (255) if it kept the whole name.
+  test::temp_dir dir;
+  const std::string name(250, 'n'), path = dir / name;
+  write_file_atomic(path, "first");
+  CHECK(read_file(path) == "first");
+  write_file_atomic(path, "second");
+  CHECK(read_file(path) == "second");
+  CHECK(entries(dir.path.string()) == std::set<std::string>{name});
+}
+
 TEST_CASE("write_file_atomic into a missing directory throws and creates nothing", "[file_io]") {
   test::temp_dir dir;
   const std::string path = dir / "missing/out.exr";

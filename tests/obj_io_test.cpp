@@ -418,6 +418,19 @@ TEST_CASE("the energy warning sums a material's own Kd and Ks: 0 and Ks without 
   CHECK_THAT(said, Catch::Contains("m.mtl: materials 'bright', 'tex' have Kd + Ks above 1"));
 }
 
+TEST_CASE("dissolve is said to be not rendered for d below 1 or Tr above 0 only, at its first line", "[obj]") {
+  // d 1 and Tr 0 are opaque (what most exporters write for every material): no warning for them.
+  temp_dir dir;
+  dir.write("o.mtl", "newmtl opaque\nKd 0.5 0.5 0.5\nd 1\nTr 0\n");
+  std::string said =
+      load_warnings(dir.write("o.obj", "mtllib o.mtl\n" + std::string(square_vertices) + "usemtl opaque\nf 1 2 3\n"));
+  CHECK(count_of(said, "dissolve") == 0);
+  dir.write("t.mtl", "newmtl opaque\nKd 0.5\nd 1\nTr 0\nnewmtl glass\nKd 0.5\nTr 0.25\nd 0.5\n");
+  said = load_warnings(dir.write("t.obj", "mtllib t.mtl\n" + std::string(square_vertices) + "usemtl glass\nf 1 2 3\n"));
+  CHECK_THAT(said, Catch::Contains("t.mtl:7: dissolve (d below 1 or Tr above 0) is not rendered"));
+  CHECK(count_of(said, "dissolve") == 1);
+}
+
 TEST_CASE("a map_Kd under Kd 0 is said to render black", "[obj]") {
   // Maya writes Kd 0 0 0 with map_Kd: the texture, multiplied by Kd, never shows, and the surface rendered black
   // without a word. Emitters show their Ke (a lamp that does not reflect is a choice); without Kd the texture shows.

@@ -159,6 +159,15 @@ TEST_CASE("time spent between passes (checkpoints) counts in the render's second
   // what turned out to be the last pass.)
   CHECK(calls >= timed.passes - 1);
   CHECK(calls <= timed.passes);
+  // A budget the first pass spends by itself (any pass takes longer than a nanosecond): no call comes after it, and
+  // the summary's time is the log's.
+  t.time_budget = 1e-9;
+  calls = 0;
+  render_result one = render(b->scene, b->bvh, b->lights, t);
+  CHECK(one.passes == 1);
+  CHECK(calls == 0);
+  REQUIRE(one.log.size() == 1);
+  CHECK(one.seconds == one.log[0].seconds);
 }
 
 TEST_CASE("an oracle interrupted while it learns leaves no frozen model behind", "[passes]") {

@@ -107,3 +107,24 @@ TEST_CASE("a note printed while warnings are written lands between them, never i
   CHECK(notes == 1);
   CHECK(warnings > 0);
 }
+
+TEST_CASE("the progress bar fills its columns by the fraction done and gives times as h:mm:ss", "[progress]") {
+  // Half of 10 spp done after 3725 s (a resumed render's, counted as elapsed): 15 of 30 columns, and as much left.
+  stderr_capture cap;
+  progress_counters c;
+  c.pass = 3;
+  c.spp_done = 5;
+  c.spp_target = 10;
+  c.seconds_before = 3725;
+  { progress_bar bar(c, true); }  // (draws at once, and its final line when it ends)
+  const std::string text = cap.text();
+  REQUIRE(!text.empty());
+  CHECK(text.back() == '\n');
+  const std::string last = text.substr(text.rfind('\r') + 1);
+  INFO(last);
+  CHECK(last.rfind("[" + std::string(15, '=') + ">" + std::string(14, ' ') + "] pass 3  spp 5/10  ", 0) == 0);
+  // 1:02:05 plus the moments the bar ran (1:02:0x: not a timing, whatever the machine's load).
+  CHECK(last.find("  1:02:0") != std::string::npos);
+  CHECK(last.find(" elapsed  1:02:0") != std::string::npos);
+  CHECK(last.find(" left") != std::string::npos);
+}
