@@ -291,11 +291,11 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   progress.spp_done = done;
   for (int pass = result.passes; done < target; pass++) {
     if (params.time_budget > 0 && result.seconds >= params.time_budget) break;
-    // A first pass that a signal arriving during it lets finish (render_params::finish_first_pass); one that came
-    // before it (an interrupted oracle's learning, the buffers' preparation) stops the render here, as it stops later
-    // passes.
+    // A first pass that a signal lets finish (render_params::finish_first_pass): one arriving during it, or before it
+    // (as the scene loaded, the render set up, the buffers were prepared: install_interrupt_handlers), unless a second
+    // request came or the signal cut --bayes-oracle's learning short; otherwise a signal stops the render here, as it
+    // stops later passes.
     const bool first = params.finish_first_pass && pass == 0 && done == 0;
-    // (`render`: a first signal before this pass, as the scene loaded or the render set up, lets it run too)
     if (g_signal.load() != 0 && !(first && !g_no_first_pass.load() && !second_request())) {
       g_first_pass.store(false);
       result.interrupted = true;
