@@ -409,6 +409,9 @@ int report_interruption(const render_options& o, int frames, bool interrupted, i
 }
 
 int run_render(const render_options& o) {
+  // (Held back until the handlers are installed below, in the mode the checkpoint's header decides: none takes the
+  // default action, and one that came first is delivered there.)
+  block_interrupt_signals();
   // A render saved at --checkpoint that this one does not resume would be replaced by this one's first checkpoint:
   // it is said, and a signal before this render's first pass ends (the user's answer to that) writes nothing.
   std::error_code ec;

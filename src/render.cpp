@@ -566,6 +566,16 @@ image_data film_image(const render_result& r) {
   return img;
 }
 
+// Blocks or unblocks (how: SIG_BLOCK, SIG_UNBLOCK) SIGINT, SIGTERM and SIGHUP for the calling thread.
+static void mask_interrupt_signals(int how) {
+  sigset_t s;
+  sigemptyset(&s);
+  sigaddset(&s, SIGINT);
+  sigaddset(&s, SIGTERM);
+  sigaddset(&s, SIGHUP);
+  pthread_sigmask(how, &s, nullptr);
+}
+
 void install_interrupt_handlers(bool finish_first_pass, bool resuming) {
   g_finish_early.store(finish_first_pass);
   g_resuming.store(resuming);
@@ -578,13 +588,9 @@ void install_interrupt_handlers(bool finish_first_pass, bool resuming) {
   set_fifo_wait_check(interrupt_count);  // an output FIFO's wait for its reader ends on a signal that arrives in it
   // A process started with them blocked (a launcher's mask is inherited) could not be interrupted at all; one that
   // arrived meanwhile is delivered now.
-  sigset_t s;
-  sigemptyset(&s);
-  sigaddset(&s, SIGINT);
-  sigaddset(&s, SIGTERM);
-  sigaddset(&s, SIGHUP);
-  pthread_sigmask(SIG_UNBLOCK, &s, nullptr);
+  mask_interrupt_signals(SIG_UNBLOCK);
 }
+void block_interrupt_signals() { mask_interrupt_signals(SIG_BLOCK); }
 int interrupt_signal() { return g_signal.load(); }
 const char* signal_name(int sig) {
   return sig == SIGTERM ? "SIGTERM" : sig == SIGINT ? "SIGINT" : sig == SIGHUP ? "SIGHUP" : "signal";

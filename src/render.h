@@ -128,6 +128,8 @@ image_data film_image(const render_result& r);
 // command go on to render it and write its image (resuming: to write the image of the checkpoint's passes); a second
 // one, half a second or more later, ends it at once.
 void install_interrupt_handlers(bool finish_first_pass = false, bool resuming = false);
+// Blocks SIGINT, SIGTERM and SIGHUP until install_interrupt_handlers unblocks them (a signal meanwhile waits there).
+void block_interrupt_signals();
 int interrupt_signal();
 // How many SIGINT/SIGTERM the handlers have received so far.
 int interrupt_count();
