@@ -621,17 +621,23 @@ TEST_CASE("at equal time the mean curve averages runs at common times", "[compar
   CHECK(st[0].relmse == Approx(0.5).epsilon(1e-12));
 }
 
-TEST_CASE("an interrupted equal-time comparison compares the samplers where the shortest run ended", "[compare]") {
-  // SIGINT during the second sampler: the first ran to the 2 s budget, the second stopped at 0.88 s. The speed-up
-  // compared the first's error at 2 s with the second's at 0.88 s (0.65 in a review, 0.99 at a common time).
+// An equal-time comparison (2 s) that SIGINT stopped during the second sampler, whose passes end at `second`; the
+// first ran to the budget. Both samplers have the same error at the same time.
+static compare_data interrupted_comparison(const std::vector<double>& second) {
   compare_data d;
   d.samplers.resize(2);
   d.equal_time = true;
   d.time_budget = 2;
   d.signal = 2;
-  // Both samplers have the same error at the same time.
   d.samplers[0].runs.push_back(run_of({0.25, 0.5, 1.0, 2.1}, 0.1));
-  d.samplers[1].runs.push_back(run_of({0.3, 0.6, 0.88}, 0.1));
+  d.samplers[1].runs.push_back(run_of(second, 0.1));
+  return d;
+}
+
+TEST_CASE("an interrupted equal-time comparison compares the samplers where the shortest run ended", "[compare]") {
+  // SIGINT during the second sampler: the first ran to the 2 s budget, the second stopped at 0.88 s. The speed-up
+  // compared the first's error at 2 s with the second's at 0.88 s (0.65 in a review, 0.99 at a common time).
+  compare_data d = interrupted_comparison({0.3, 0.6, 0.88});
   CHECK(comparison_time(d) == 0.88);
   std::vector<compare_stats> st = comparison_stats(d);
   REQUIRE(st.size() == 2);
@@ -648,13 +654,7 @@ TEST_CASE("an interrupted equal-time comparison compares the samplers where the 
 
 TEST_CASE("an interrupted comparison whose shortest run ended with its first pass compares there", "[compare]") {
   // The second sampler's only pass ends at 0.6 s, the comparison time: its error is known there, not later.
-  compare_data d;
-  d.samplers.resize(2);
-  d.equal_time = true;
-  d.time_budget = 2;
-  d.signal = 2;
-  d.samplers[0].runs.push_back(run_of({0.25, 0.5, 1.0, 2.1}, 0.1));
-  d.samplers[1].runs.push_back(run_of({0.6}, 0.1));
+  compare_data d = interrupted_comparison({0.6});
   REQUIRE(comparison_time(d) == 0.6);
   std::vector<compare_stats> st = comparison_stats(d);
   REQUIRE(st.size() == 2);
