@@ -575,6 +575,23 @@ bool holds_checkpoint(const std::string& path) {
   return f.read(head, sizeof head) && std::memcmp(head, magic, sizeof magic) == 0;
 }
 
+int saved_passes(const std::string& path, int frames) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return -1;
+  std::ifstream f(path, std::ios::binary);
+  // (as emit_checkpoint writes them: the pass count follows the width and height, or an animation's frame and flag)
+  const size_t at = checkpoint_frame_offset + (frames > 1 ? sizeof(int) + 1 : 0);
+  std::string head(at + sizeof(int), '\0');
+  uint32_t stored_version, parts;
+  int passes;
+  if (!f.read(head.data(), std::streamsize(head.size())) || std::memcmp(head.data(), magic, sizeof magic) != 0)
+    return -1;
+  std::memcpy(&stored_version, head.data() + sizeof magic, sizeof stored_version);
+  std::memcpy(&parts, head.data() + sizeof magic + 4 + 8, sizeof parts);
+  std::memcpy(&passes, head.data() + at, sizeof passes);
+  return stored_version == version && parts == fp_part_count && passes >= 0 ? passes : -1;
+}
+
 uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
                            const render_fingerprint_data& fingerprint, const render_params& params,
                            render_result& result, light_sampler& sampler) {

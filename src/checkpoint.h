@@ -55,6 +55,10 @@ void write_checkpoint(const std::string& path, const render_fingerprint_data& fi
 // Whether the regular file at path starts as a checkpoint does (false where it cannot be read): a render given it as
 // --checkpoint without --resume would replace a saved render.
 bool holds_checkpoint(const std::string& path);
+// The number of passes of its frame that the checkpoint at path holds, read from its header alone (`frames`: the
+// render's, render_params::frames); -1 where the file cannot be read as a checkpoint of this version (the resume
+// then refuses it, naming why). An animation stopped before a frame's first pass saved that frame with none.
+int saved_passes(const std::string& path, int frames);
 
 // Restores a state written by write_checkpoint into a freshly built sampler of the same kind and the result;
 // throws input_error naming `path` when the data are malformed or were written for another scene/options (naming

@@ -420,7 +420,12 @@ int run_render(const render_options& o) {
   // A first signal from here on lets the render go on to write the image of a first pass (of the checkpoint's passes
   // when resuming), except where that would replace a saved render, or follow --bayes-oracle's learning cut short
   // (the set-up then ends at once, as before any learning).
-  install_interrupt_handlers(!replaces_saved && (o.bayes.oracle_spp == 0 || !o.resume.empty()), !o.resume.empty());
+  // A resumed checkpoint without a pass of its frame (an animation stopped before that frame's first) has no image to
+  // write: a signal in the set-up ends the render at once, as in a later frame of one render (left over at stop 43:
+  // the message promised the image of the checkpoint's passes, and nothing came).
+  const bool resumes_no_pass = !o.resume.empty() && saved_passes(o.resume, std::max(1, o.frames)) == 0;
+  install_interrupt_handlers(!replaces_saved && !resumes_no_pass && (o.bayes.oracle_spp == 0 || !o.resume.empty()),
+                             !o.resume.empty());
   sampler_kind kind;
   if (!parse_sampler_kind(o.sampler, kind))
     throw usage_error("unknown sampler \"" + o.sampler + "\" (valid: " + sampler_names() + ")");

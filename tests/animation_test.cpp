@@ -350,6 +350,20 @@ TEST_CASE("an animation killed, interrupted or stopped between frames resumes to
       if (std::string(st.how) == "--stop-after-passes 17")
         CHECK(r1.output.find("the animation stopped in frame 1 of 3; frame 2 was not rendered; --resume " + ck +
                              " continues it") != std::string::npos);
+      if (std::string(st.how) == "--checkpoint-every 1000 --signal-in-frame 1") {
+        // Its resume interrupted in the set-up: frame 1 has no pass to write, so it ends there, the checkpoint as it
+        // was (it promised "the image of the checkpoint's passes", and wrote nothing).
+        const std::string saved = read_file(ck);
+        auto early = run_bayeslight(args + " -o " + (a.dir / "part_%d.pfm") + " --resume " + ck +
+                                    " --checkpoint " + ck + " --signals-in-setup 1");
+        INFO(early.output);
+        CHECK(early.status == 130);
+        CHECK(early.output.find("bayeslight: interrupted (SIGINT) while setting up the render; nothing written\n") !=
+              std::string::npos);
+        CHECK(early.output.find("going on") == std::string::npos);
+        CHECK(read_file(ck) == saved);
+        CHECK(!std::filesystem::exists(frame("part", 1)));
+      }
       auto r2 = run_bayeslight(args + " -o " + (a.dir / "part_%d.pfm") + " --resume " + ck);
       INFO(r2.output);
       REQUIRE(r2.status == 0);

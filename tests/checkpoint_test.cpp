@@ -233,6 +233,28 @@ TEST_CASE("a checkpoint resumed for one spp more after a pass of several goes on
   CHECK(read_file(d / "resumed.pfm") == read_file(d / "full.pfm"));
 }
 
+TEST_CASE("a checkpoint's header says how many passes it holds", "[checkpoint]") {
+  // saved_passes: read before the render sets up (a resume whose checkpoint holds no pass of its frame has no image
+  // to write for a signal). 10 spp: the passes 1 2 3 4 5 6 7 8 10.
+  temp_dir d;
+  std::string ck = d / "ck.bin";
+  render_checkpoint(cornell_args("bound", 16, 12), 10, d, ck);
+  CHECK(saved_passes(ck, 1) == 9);
+  CHECK(saved_passes(d / "a.pfm", 1) == -1);        // not a checkpoint
+  CHECK(saved_passes(d / "missing.bin", 1) == -1);  // no file
+  CHECK(saved_passes(d.path.string(), 1) == -1);    // a folder
+  // Another version, or cut short in its header: not read.
+  std::string bytes = read_file(ck);
+  std::string other = bytes;
+  other[16] ^= 1;
+  write_text(d / "other.bin", other);
+  CHECK(saved_passes(d / "other.bin", 1) == -1);
+  write_text(d / "short.bin", bytes.substr(0, checkpoint_frame_offset + 3));
+  CHECK(saved_passes(d / "short.bin", 1) == -1);
+  write_text(d / "header.bin", bytes.substr(0, checkpoint_frame_offset + 4));
+  CHECK(saved_passes(d / "header.bin", 1) == 9);
+}
+
 TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[checkpoint]") {
   temp_dir d;
   std::string ck = d / "ck.bin";
