@@ -55,7 +55,9 @@ __m128 gloss_factor4(const shade_point& sp, __m128 cos_a, __m128 sin_t) {
 }
 
 // The floor of a cluster's positive member weights: min_positive_share of `raw`, the cluster's column (the sum of
-// those weights), so that, as in fill_cdf, no member that can contribute rounds to probability zero.
+// those weights), so that, as in fill_cdf, no member that can contribute rounds to probability zero. (Its draw
+// rescales u's place in the cluster's cell, which holds about pj 2^53 values of u: a floored member of a floored
+// cluster, below 2^-53 of the total, is drawn at that resolution rather than at its pmf; README, "All are unbiased".)
 double member_floor(float raw) { return std::isfinite(raw) ? double(raw) * min_positive_share : 0.0; }
 // The total weight of the n members w[0..n) of a cluster, each positive weight floored at `floor`.
 double members_total(const float* w, int n, double floor) {

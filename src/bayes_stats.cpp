@@ -264,21 +264,21 @@ double posterior_weight(const bayes_params& p, double bound, double scale, doubl
     // Naive plug-in estimates; a cluster without samples follows its bound.
     double n = n0 + n1;
     if (n == 0) return mu0 / d2;
-    double p0 = n0 / n;
+    double p1 = n1 / n;  // (E[1 - p0] formed directly: 1 - p0 cancels when n0 is large, a review)
     double h = n1 >= 2 ? m2 / n1 : 0.0;
-    if (!p.second_moment) return (1 - p0) * mean / d2;
-    return std::sqrt((1 - p0) * (mean * mean + h)) / d2;
+    if (!p.second_moment) return p1 * mean / d2;
+    return std::sqrt(p1 * (mean * mean + h)) / d2;
   }
-  double p0 = (p.a0 + n0) / (p.a0 + p.b0 + n0 + n1);
+  double p1 = (p.b0 + n1) / (p.a0 + p.b0 + n0 + n1);
   double kn = p.kappa0 + n1;
   double mun = (p.kappa0 * mu0 + n1 * mean) / kn;
-  if (!p.second_moment) return (1 - p0) * mun / d2;
+  if (!p.second_moment) return p1 * mun / d2;
   double an = p.alpha0 + 0.5 * n1;
   double beta0 = p.c * mu0 * mu0 * (p.alpha0 - 1);
   double dm = mean - mu0;
   double bn = beta0 + 0.5 * (m2 + p.kappa0 * n1 * dm * dm / kn);
   double h = bn / (an - 1);
-  return std::sqrt((1 - p0) * (mun * mun + h)) / d2;
+  return std::sqrt(p1 * (mun * mun + h)) / d2;
 }
 
 }  // namespace bl
