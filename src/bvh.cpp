@@ -91,6 +91,11 @@ bvh_data build_bvh(const scene_data& s) {
     rtcAttachGeometry(b.scene, geom);
     rtcReleaseGeometry(geom);
   }
+  // Embree's commit sets flush-to-zero and denormals-are-zero on this thread while it builds; where that is the
+  // thread's first use of TBB, TBB's implicit arena captures them, and every later parallel_for outside an explicit
+  // arena (bayes' learning between passes, the regions' set-up) ran with them while the passes (their own arena) did
+  // not: a prior mean below FLT_MIN became 0 there and its cluster unchoosable. Join TBB first, in this thread's mode.
+  tbb::parallel_for(0, 1, [](int) {});
   rtcCommitScene(b.scene);
   if (!error.empty()) throw std::runtime_error(error);
   rtcSetDeviceErrorFunction(b.device, nullptr, nullptr);
