@@ -8,11 +8,12 @@
 #include "render.h"
 #include "rng.h"
 #include "scene.h"
+#include "scene_fixture.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
 #include <tbb/parallel_for.h>
-#include <xmmintrin.h>
+#include <pmmintrin.h>
 
 #include <atomic>
 
@@ -127,13 +128,8 @@ TEST_CASE("TBB work after the BVH's build keeps denormals (no flush-to-zero)", "
   // radiance 1e-37 rendered 1.3 % dark with bayes). Run as its own process (ctest), the BVH is its first use of TBB.
   mesh_builder b;
   b.add_quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, b.add_material({0.5f, 0.5f, 0.5f}));
-  camera_params cam;
-  cam.automatic = false;
-  cam.eye = {0, 1, 3};
-  cam.target = {0, 0, 0};
-  scene_data scene = build_scene(std::move(b.mesh), cam, {}, false, 1.0f);
-  bvh_data bvh = build_bvh(scene);
+  auto t = build_test_scene(std::move(b.mesh), fixed_camera({0, 1, 3}, {0, 0, 0}));
   std::atomic<unsigned> modes{0};
-  tbb::parallel_for(0, 64, [&](int) { modes.fetch_or(_mm_getcsr() & (_MM_FLUSH_ZERO_MASK | 0x0040u)); });
+  tbb::parallel_for(0, 64, [&](int) { modes.fetch_or(_mm_getcsr() & (_MM_FLUSH_ZERO_MASK | _MM_DENORMALS_ZERO_MASK)); });
   CHECK(modes.load() == 0u);
 }
