@@ -627,7 +627,10 @@ int run_compare_command(const compare_options& o) {
   std::vector<std::string> names;
   for (size_t b = 0;;) {
     size_t e = o.samplers.find(',', b);
-    names.push_back(o.samplers.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    // Blanks around a name are dropped ("bound, bayes", as a list is often written).
+    std::string name = o.samplers.substr(b, e == std::string::npos ? std::string::npos : e - b);
+    const size_t first = name.find_first_not_of(" \t"), last = name.find_last_not_of(" \t");
+    names.push_back(first == std::string::npos ? std::string() : name.substr(first, last - first + 1));
     if (e == std::string::npos) break;
     b = e + 1;
   }

@@ -20,8 +20,9 @@ void add_render_options(CLI::App* r, render_options& o) {
                    ->check(CLI::Range(1e-6, 1e9))->check(finite_number);
   spp->excludes(time);
   r->add_option("--max-depth", o.max_depth,
-                "Path length in segments; 1 = direct illumination only (camera ray, NEE and emission seen), 2 adds "
-                "one bounce (default: the scene's render.max_depth)")
+                "Path length in segments; 1 = direct illumination only (camera ray, NEE and emission seen; a sharp "
+                "glossy lobe then sees lamps through light samples alone, noisily: see README), 2 adds one bounce "
+                "(default: the scene's render.max_depth)")
       ->check(CLI::Range(1, 1000));
   r->add_option("--light-samples", o.light_samples,
                 "NEE samples at every path vertex, each its own light, point and shadow ray, averaged (default 1)")

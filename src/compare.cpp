@@ -303,7 +303,8 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
                          : "- **mean curve**: the runs' relMSE and seconds averaged pass by pass.\n";
   s += "- **seconds**: render wall time (passes and learning), mean over runs; it excludes the setup column (light "
        "tree, regions) and error computation. Every pass is in curves.csv; error_vs_time.svg plots the mean curves.\n";
-  s += format("- **images**: `<sampler>.exr` is the render of run 1 (seed %llu); `<sampler>_error.png` shows its "
+  s += format("- **images**: `<sampler>.exr` is the render of run 1 (seed %llu), `<sampler>.png` the same as 8-bit sRGB "
+              "(clamped); `<sampler>_error.png` shows its "
               "per-pixel relative error |x \xe2\x88\x92 r| / (|r| + 0.1), averaged over RGB, on the viridis ramp with "
               "the fixed logarithmic range %g (dark purple, and below) to %g (yellow, and above).\n",
               (unsigned long long)rp.seed, double(p.error_image.min_error), double(p.error_image.max_error));
@@ -328,6 +329,9 @@ std::string comparison_svg(const compare_data& data, const compare_params& p) {
 static std::string image_file(const compare_params& p, sampler_kind k) {
   return out_path(p, std::string(sampler_name(k)) + ".exr");
 }
+static std::string png_file(const compare_params& p, sampler_kind k) {
+  return out_path(p, std::string(sampler_name(k)) + ".png");
+}
 static std::string error_file(const compare_params& p, sampler_kind k) {
   return out_path(p, std::string(sampler_name(k)) + "_error.png");
 }
@@ -342,11 +346,11 @@ void write_comparison(const compare_data& data, const compare_params& p, const i
       // Interrupted before this sampler's first pass: images an earlier comparison left here would sit beside a
       // summary that lists none for it.
       std::error_code ec;
-      fs::remove(image_file(p, s.kind), ec);
-      fs::remove(error_file(p, s.kind), ec);
+      for (const std::string& f : {image_file(p, s.kind), png_file(p, s.kind), error_file(p, s.kind)}) fs::remove(f, ec);
       continue;
     }
     failures.attempt([&] { write_image(image_file(p, s.kind), s.image); });
+    failures.attempt([&] { write_image(png_file(p, s.kind), s.image); });
     failures.attempt([&] { write_error_image(error_file(p, s.kind), s.image, reference, p.error_image); });
   }
   failures.attempt([&] { write_file_atomic(out_path(p, curves_file), comparison_csv(data)); });
@@ -358,7 +362,7 @@ void write_comparison(const compare_data& data, const compare_params& p, const i
   for (sampler_kind k : all_sampler_kinds) {
     if (std::find(p.samplers.begin(), p.samplers.end(), k) != p.samplers.end()) continue;
     std::error_code ec;
-    for (const std::string& f : {image_file(p, k), error_file(p, k)})
+    for (const std::string& f : {image_file(p, k), png_file(p, k), error_file(p, k)})
       if (fs::exists(f, ec)) stale += (stale.empty() ? "" : ", ") + fs::path(f).filename().string();
   }
   if (!stale.empty())
@@ -396,6 +400,7 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
     for (const std::string& src : scene.mesh.source_files) ins.push_back({src, "scene input"});
     for (sampler_kind k : params.samplers) {
       outs.push_back({image_file(params, k), "output"});
+      outs.push_back({png_file(params, k), "output"});
       outs.push_back({error_file(params, k), "output"});
     }
     for (const char* f : {curves_file, plot_file, summary_file}) outs.push_back({out_path(params, f), "output"});
@@ -432,7 +437,7 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   const int sig = data.signal != 0 ? data.signal : interrupt_signal();
   if (!params.quiet || sig != 0)
     std::fprintf(stderr, "compare: %s -> %s (summary.md, curves.csv, error_vs_time.svg, <sampler>.exr, "
-                         "<sampler>_error.png)\n",
+                         "<sampler>.png, <sampler>_error.png)\n",
                  data.signal != 0 ? "interrupted; wrote the passes completed so far"
                  : sig != 0       ? "interrupted after the last render; wrote everything"
                                   : "done",

@@ -174,6 +174,20 @@ static int find_channel(const EXRHeader& h, const char* name) {
   return -1;
 }
 
+// The layer names P for which P.R, P.G and P.B are all channels of h (a multi-layer file in one part, as Blender's
+// "OpenEXR MultiLayer" writes: ViewLayer.Combined.R, ...), in the order of their R channels.
+static std::vector<std::string> rgb_layers(const EXRHeader& h) {
+  std::vector<std::string> layers;
+  for (int c = 0; c < h.num_channels; ++c) {
+    const std::string name = h.channels[c].name;
+    if (name.size() < 3 || name.compare(name.size() - 2, 2, ".R") != 0) continue;
+    const std::string layer = name.substr(0, name.size() - 2);
+    if (find_channel(h, (layer + ".G").c_str()) >= 0 && find_channel(h, (layer + ".B").c_str()) >= 0)
+      layers.push_back(layer);
+  }
+  return layers;
+}
+
 // Sample i of loaded channel plane p (FLOAT after the HALF->FLOAT request, or UINT).
 static float exr_sample(const unsigned char* p, int pixel_type, size_t i) {
   if (pixel_type == TINYEXR_PIXELTYPE_UINT) return float(reinterpret_cast<const unsigned int*>(p)[i]);
@@ -228,8 +242,8 @@ static exr_precheck exr_header_precheck(const unsigned char* mem, size_t size) {
   return out;
 }
 
-// Reads R, G, B of a single-part scanline EXR (without them Y, or a file's only channel, is replicated to grey;
-// luminance/chroma and XYZ files are refused);
+// Reads R, G, B of a single-part scanline EXR (without them the one layer's L.R, L.G, L.B, or Y, or a file's only
+// channel, replicated to grey; luminance/chroma and XYZ files, and several RGB layers, are refused);
 // alpha and other channels are ignored. Tiled files are rejected: tinyexr's tiled error paths free memory unreliably.
 static image_data read_exr(const std::string& path) {
   std::string bytes = read_file(path);
@@ -254,7 +268,17 @@ static image_data read_exr(const std::string& path) {
     throw input_error(path, "malformed OpenEXR header: " + take_exr_error(err, "unknown error"));
   const EXRHeader& h = exr.header;
   int rgb[3] = {find_channel(h, "R"), find_channel(h, "G"), find_channel(h, "B")};
+  const std::vector<std::string> layers = rgb_layers(h);
+  if ((rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) && layers.size() == 1)
+    for (int c = 0; c < 3; ++c) rgb[c] = find_channel(h, (layers[0] + "." + "RGB"[c]).c_str());
   if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
+    if (layers.size() > 1) {
+      std::string names;
+      for (size_t i = 0; i < layers.size() && i < 8; ++i) names += (i ? ", " : "") + layers[i];
+      throw input_error(path, "OpenEXR file has " + std::to_string(layers.size()) + " layers with R, G and B (" +
+                                  names + (layers.size() > 8 ? ", ..." : "") +
+                                  "): which is the image is not clear; save that layer alone");
+    }
     if (find_channel(h, "RY") >= 0 || find_channel(h, "BY") >= 0)
       throw input_error(path, "luminance/chroma OpenEXR files (Y, RY, BY) are not supported (write R, G, B)");
     if (find_channel(h, "X") >= 0 && find_channel(h, "Z") >= 0)

@@ -876,7 +876,7 @@ TEST_CASE("one SIGINT ends every FIFO wait, and the outputs after a failed one a
   INFO(r.output);
   CHECK(r.status == 1);
   CHECK(r.output.find("cannot write " + (s.dir / "cmp/curves.csv")) != std::string::npos);
-  for (const char* f : {"summary.md", "error_vs_time.svg", "uniform.exr", "power.exr", "power_error.png"})
+  for (const char* f : {"summary.md", "error_vs_time.svg", "uniform.exr", "power.exr", "power.png", "power_error.png"})
     CHECK(exists(s.dir / (std::string("cmp/") + f)));
 }
 

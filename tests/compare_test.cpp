@@ -287,6 +287,11 @@ void check_outputs(const std::string& out, const std::vector<std::string>& sampl
     CHECK(img.height == 12);
     std::string png = slurp(out + "/" + s + "_error.png");
     CHECK(png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0);
+    // The render again as 8-bit sRGB: the bytes render -o would write for the same pixels.
+    const std::string own = out + "/" + s + "_own.png";
+    write_image(own, img);
+    CHECK(slurp(out + "/" + s + ".png") == slurp(own));
+    std::filesystem::remove(own);
   }
   // The plot: well-formed XML, one path per sampler, the dashed guide, every sampler in the legend.
   std::string svg = slurp(out + "/error_vs_time.svg");
@@ -328,7 +333,7 @@ TEST_CASE("compare names the images an earlier comparison left in its folder", "
   run_result r = run_bayeslight(args + " --samplers bvh,uniform");
   INFO(r.output);
   REQUIRE(r.status == 0);
-  CHECK(r.output.find("compare: warning: " + out + " also holds power.exr, power_error.png from an earlier "
+  CHECK(r.output.find("compare: warning: " + out + " also holds power.exr, power.png, power_error.png from an earlier "
                       "comparison (not part of this one)") != std::string::npos);
   CHECK(std::filesystem::exists(out + "/power.exr"));
   r = run_bayeslight(args + " --samplers power,bvh,uniform");
@@ -382,6 +387,7 @@ TEST_CASE("compare interrupted before any pass keeps an earlier comparison's fil
   CHECK(WEXITSTATUS(st) == 130);
   CHECK(std::filesystem::exists(out + "/uniform.exr"));
   CHECK(!std::filesystem::exists(out + "/bayes.exr"));
+  CHECK(!std::filesystem::exists(out + "/bayes.png"));
   CHECK(!std::filesystem::exists(out + "/bayes_error.png"));
   CHECK(slurp(out + "/summary.md").find("Interrupted") != std::string::npos);
 }
@@ -389,8 +395,9 @@ TEST_CASE("compare interrupted before any pass keeps an earlier comparison's fil
 TEST_CASE("compare repeats runs with consecutive seeds and reports mean and deviation", "[compare]") {
   compare_scene s;
   std::string out = s.dir / "out";
+  // (A blank after the comma, as a list is often written, is dropped: it was an unknown sampler " bayes".)
   run_result r = run_bayeslight("compare " + s.json + " --reference " + s.ref +
-                                " --spp 3 --runs 3 --seed 7 --samplers power,bayes --out " + out +
+                                " --spp 3 --runs 3 --seed 7 --samplers 'power, bayes' --out " + out +
                                 " --reference-note 'reference: 16 spp uniform, seed 99' --quiet");
   INFO(r.output);
   REQUIRE(r.status == 0);
@@ -458,6 +465,8 @@ TEST_CASE("bad compare invocations exit 2 or 3 and write nothing", "[compare]") 
       {base + "--reference " + s.ref + " --spp 2 --samplers uniform,,power", 2, "empty name"},
       {base + "--reference " + s.ref + " --spp 2 --samplers uniform,", 2, "empty name"},
       {base + "--reference " + s.ref + " --spp 2 --samplers \"\"", 2, "empty name"},
+      {base + "--reference " + s.ref + " --spp 2 --samplers \"uniform, \"", 2, "empty name"},
+      {base + "--reference " + s.ref + " --spp 2 --samplers \"uniform, Uniform\"", 2, "unknown sampler \"Uniform\""},
       {base + "--reference " + s.ref + " --spp 2 --samplers uniform --runs 0", 2, "--runs"},
       {base + "--reference " + s.ref + " --spp 2 --samplers uniform --frames 2", 2, "--frames"},
       {"compare " + s.json + " --reference " + s.ref + " --spp 2 --samplers uniform", 2, "--out"},

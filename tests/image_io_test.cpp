@@ -267,6 +267,18 @@ TEST_CASE("EXR files in any line order, and grey ones with alpha, read as writte
   // Two channels, neither R, G, B nor Y: refused, naming what the file has.
   write_file_atomic(dir / "uv.exr", handmade_exr(w, h, {"U", "V"}, {alpha, lum}, 0));
   CHECK_THAT(read_error(dir / "uv.exr"), Catch::Contains("found: U, V"));
+  // One layer of R, G and B in a multi-layer file (Blender's "OpenEXR MultiLayer": ViewLayer.Combined.R, ...): that
+  // layer is the image (it was refused as having no R, G and B; a review). Two such layers: refused, naming both.
+  write_file_atomic(dir / "layer.exr",
+                    handmade_exr(w, h,
+                                 {"ViewLayer.Combined.A", "ViewLayer.Combined.B", "ViewLayer.Combined.G",
+                                  "ViewLayer.Combined.R", "ViewLayer.Depth.Z"},
+                                 {alpha, bgr[0], bgr[1], bgr[2], lum}, 0));
+  image_data layered = read_image(dir / "layer.exr");
+  CHECK(layered.pixels == expected);
+  write_file_atomic(dir / "layers.exr", handmade_exr(w, h, {"a.B", "a.G", "a.R", "b.B", "b.G", "b.R"},
+                                                     {bgr[0], bgr[1], bgr[2], bgr[0], bgr[1], bgr[2]}, 0));
+  CHECK_THAT(read_error(dir / "layers.exr"), Catch::Contains("2 layers with R, G and B (a, b)"));
   // A data window that is not the display window (a crop, an overscan) was read as if it were the image (a review).
   for (int overscan : {1, -1}) {
     write_file_atomic(dir / "window.exr", handmade_exr(w, h, {"B", "G", "R"}, bgr, 0, 0, overscan));

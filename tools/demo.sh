@@ -16,18 +16,16 @@ if [ ! -f "$ref" ]; then
   echo "rendering the reference once (bayes sampler, 2048 spp, seed 1000003) -> $ref"
   "$bin" render "$scene" --sampler bayes --spp 2048 --seed 1000003 --width "$W" --height "$H" -o "$ref"
 fi
-for s in bayes bound; do
-  echo "rendering $scene with the $s sampler for $T s"
-  "$bin" render "$scene" --sampler "$s" --time "$T" --width "$W" --height "$H" --reference "$ref" \
-    --log "$out/living_room_$s.csv" -o "$out/living_room_$s.exr" -o "$out/living_room_$s.png"
-done
+# compare renders both for T s each (bound first: the baseline of its speed-up column) and writes the images
+# (<sampler>.exr and .png), a false-colour error image of each, every pass's error (curves.csv), the plot of relMSE
+# against time (error_vs_time.svg) and the equal-time table (summary.md).
+echo "rendering $scene with the bound and the bayes sampler for $T s each"
+"$bin" compare "$scene" --samplers bound,bayes --time "$T" --width "$W" --height "$H" --reference "$ref" \
+  --reference-note "bayes, 2048 spp, seed 1000003" --out "$out"
 echo
-echo "error against time (relMSE vs the reference; full per-pass curves in $out/*.csv):"
-for s in bayes bound; do
-  tail -n 1 "$out/living_room_$s.csv" | awk -F, '{printf "  %-6s %5d spp in %6.2f s  relMSE %.5g (its last pass)\n", $1, $3, $4, $5}'
-done
-# Each render ends with the pass under way at T: the errors are compared at exactly T (interpolated between passes).
-read -r b _ < <(awk -F, -v T="$T" -f tools/at_time.awk "$out/living_room_bayes.csv")
-read -r n _ < <(awk -F, -v T="$T" -f tools/at_time.awk "$out/living_room_bound.csv")
-awk -v b="$b" -v n="$n" -v T="$T" 'BEGIN { printf "  bayes speed-up over bound at equal time (relMSE at %g s): %.1fx\n", T, n / b }'
-echo "images: $out/living_room_bayes.png (.exr), $out/living_room_bound.png (.exr)"
+echo "error against time (relMSE vs the reference at $T s; every pass in $out/curves.csv):"
+# The table's rows: sampler, spp, seconds, relMSE at T, speed-up over bound at equal time.
+awk -F'|' '$2 ~ /^ (bound|bayes) $/ {for (i = 2; i <= 6; i++) gsub(/ /, "", $i); printf "  %-6s %5d spp in %6.2f s  relMSE %s  speed-up over bound %sx\n", $2, $3, $4, $5, $6}' \
+  "$out/summary.md"
+echo "report: $out/summary.md, plot: $out/error_vs_time.svg"
+echo "images: $out/bayes.png (.exr), $out/bound.png (.exr); error images: $out/bayes_error.png, $out/bound_error.png"
