@@ -381,7 +381,7 @@ float bayes_sampler::members_pmf(const context& ctx, int light) const {
   return float(p);
 }
 
-void bayes_sampler::refresh_groups(const std::vector<int>* pairs) {
+void bayes_sampler::refresh_groups(const std::vector<int>* pairs, bool dirty_only) {
   if (!regions.members) return;
   size_t slots = regions.cut_nodes.size();
   stats.gw.resize(slots + 4, 0.0f);
@@ -399,6 +399,9 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs) {
     size_t k = first;
     for (; k < npairs && slot[k] == g; k++) {
       a += stats.w[k], b += stats.w_cv[k], c += stats.cv[k];
+      // A member without a control variate (most) adds +0 to each colour sum, which starts at +0 and can only stay
+      // >= +0 (colours and cv are finite and non-negative): the same bits without reading its node's colour.
+      if (stats.cv[k] == 0) continue;
       int node = regions.pair_node[k];
       vec3f col = node == sun_cluster ? sun_color : tree->color[size_t(node)];
       r += double(col.x) * stats.cv[k], gr += double(col.y) * stats.cv[k], bl += double(col.z) * stats.cv[k];
@@ -411,18 +414,28 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs) {
     stats.gtot[size_t(g)] = members_total(stats.w.data() + first, n, member_floor(stats.gw[size_t(g)]));
     stats.gtot_cv[size_t(g)] = members_total(stats.w_cv.data() + first, n, member_floor(stats.gw_cv[size_t(g)]));
   };
+  const std::vector<uint8_t>& dirty = stats.scratch.dirty;
   if (!pairs) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, regions.key.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t i = r.begin(); i < r.end(); i++) {
         size_t b = size_t(regions.pair_offset[i]), e = b + size_t(regions.pair_count[i]);
-        for (size_t k = b; k < e; k++)
-          if (k == b || slot[k] != slot[k - 1]) sum_run(k);
+        if (!dirty_only) {
+          for (size_t k = b; k < e; k++)
+            if (k == b || slot[k] != slot[k - 1]) sum_run(k);
+          continue;
+        }
+        // Only the clusters with a flagged member: the others' sums are what they hold (a function of the weights).
+        for (size_t k = b; k < e;) {
+          size_t first = k;
+          bool any = false;
+          for (; k < e && slot[k] == slot[first]; k++) any |= dirty[k] != 0;
+          if (any) sum_run(first);
+        }
       }
     });
     return;
   }
   // Each listed pair was refolded and flagged (stats.scratch.dirty); the first flagged member of a cluster sums it.
-  const std::vector<uint8_t>& dirty = stats.scratch.dirty;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs->size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t < r.end(); t++) {
       size_t k = size_t((*pairs)[t]);
@@ -787,9 +800,9 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
   timing.refolds += double(folds.load());
   if (!regions.members) return;
   if (scan) {
-    // Most pairs were refolded: every cluster sums its members again (a cluster none of whose members changed gets
-    // the sum it holds), in one sweep over the regions instead of a list of the refolded pairs.
-    refresh_groups(nullptr);
+    // Most pairs were refolded: one sweep over the regions instead of a list of the refolded pairs, in which the
+    // clusters with a refolded (flagged) member sum their members again.
+    refresh_groups(nullptr, true);
     std::fill(dirty.begin(), dirty.end(), uint8_t(0));
     return;
   }

@@ -132,8 +132,9 @@ struct bayes_sampler {
   void refresh_all_weights();
   // Members: recomputes the cluster columns (gw, gw_cv, gcv) of the clusters of the given pairs (nullptr: all) from
   // their members' weights. Each cluster's sum runs over its members in order: a function of the weights only.
-  // Given pairs must be listed once each and flagged in stats.scratch.dirty (refold does both).
-  void refresh_groups(const std::vector<int>* pairs);
+  // Given pairs must be listed once each and flagged in stats.scratch.dirty (refold does both). `dirty_only` (with
+  // nullptr): only the clusters with a member flagged in stats.scratch.dirty (the others hold their sums already).
+  void refresh_groups(const std::vector<int>* pairs, bool dirty_only = false);
   // Scales every statistic by `decay` (the prior regains weight) and refreshes the weights.
   void begin_frame(double decay);
 };
