@@ -327,6 +327,7 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   row.add_at(row.slot_at(ctx.rec_block, ctx.pair_base, j), z);
 }
 
+
 light_choice bayes_sampler::sample_members(const context& ctx, double u, double u_inner) const {
   if (ctx.count == 0 || !(ctx.cdf[ctx.count] > 0)) return {};
   int j = sample_cdf(ctx.cdf, ctx.count, u);
@@ -394,25 +395,37 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs, bool dirty_onl
   size_t npairs = slot.size();
   // The sums of the run of pairs of one cluster starting at `first` (a cluster's members are consecutive pairs).
   auto sum_run = [&](size_t first) {
-    int g = slot[first];
-    double a = 0, b = 0, c = 0, r = 0, gr = 0, bl = 0;
-    size_t k = first;
-    for (; k < npairs && slot[k] == g; k++) {
-      a += stats.w[k], b += stats.w_cv[k], c += stats.cv[k];
+    const int* sl = slot.data();
+    const float *w = stats.w.data(), *wcv = stats.w_cv.data(), *cv = stats.cv.data();
+    const int g = sl[first];
+    size_t end = first + 1;
+    while (end < npairs && sl[end] == g) end++;
+    // In one sweep: the columns' sums, and members_total's totals of the positive weights as if no floor applied,
+    // with the least positive weight: where that is not below the floor (nearly always), the floor changed no term,
+    // and the total is members_total's to the bit (the same terms added in the same order).
+    double a = 0, b = 0, c = 0, r = 0, gr = 0, bl = 0, ta = 0, tb = 0;
+    float lo_a = HUGE_VALF, lo_b = HUGE_VALF;
+    for (size_t k = first; k < end; k++) {
+      const float x = w[k], y = wcv[k], z = cv[k];
+      a += x, b += y, c += z;
+      if (x > 0) ta += double(x), lo_a = std::min(lo_a, x);
+      if (y > 0) tb += double(y), lo_b = std::min(lo_b, y);
       // A member without a control variate (most) adds +0 to each colour sum, which starts at +0 and can only stay
       // >= +0 (colours and cv are finite and non-negative): the same bits without reading its node's colour.
-      if (stats.cv[k] == 0) continue;
+      if (z == 0) continue;
       int node = regions.pair_node[k];
       vec3f col = node == sun_cluster ? sun_color : tree->color[size_t(node)];
-      r += double(col.x) * stats.cv[k], gr += double(col.y) * stats.cv[k], bl += double(col.z) * stats.cv[k];
+      r += double(col.x) * z, gr += double(col.y) * z, bl += double(col.z) * z;
     }
-    stats.gw[size_t(g)] = float(a);
-    stats.gw_cv[size_t(g)] = float(b);
+    const float fa = float(a), fb = float(b);
+    stats.gw[size_t(g)] = fa;
+    stats.gw_cv[size_t(g)] = fb;
     stats.gcv[size_t(g)] = float(c);
     stats.gcol[size_t(g)] = {float(r), float(gr), float(bl)};
-    int n = int(k - first);
-    stats.gtot[size_t(g)] = members_total(stats.w.data() + first, n, member_floor(stats.gw[size_t(g)]));
-    stats.gtot_cv[size_t(g)] = members_total(stats.w_cv.data() + first, n, member_floor(stats.gw_cv[size_t(g)]));
+    const int n = int(end - first);
+    const double floor_a = member_floor(fa), floor_b = member_floor(fb);
+    stats.gtot[size_t(g)] = double(lo_a) >= floor_a ? ta : members_total(w + first, n, floor_a);
+    stats.gtot_cv[size_t(g)] = double(lo_b) >= floor_b ? tb : members_total(wcv + first, n, floor_b);
   };
   const std::vector<uint8_t>& dirty = stats.scratch.dirty;
   if (!pairs) {
@@ -706,6 +719,17 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
   // Touched pairs (their own statistics changed), flagging the coarse ones that moved.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, touched.size(), 1024), [&](const tbb::blocked_range<size_t>& g) {
     for (size_t t = g.begin(); t < g.end(); t++) {
+      // The statistics of the pair `ahead` folds on (scattered where the pass touched few pairs; each fold waits on
+      // their load), and its parent's a little later (its index is in cache by then).
+      constexpr size_t ahead = 8;
+      if (t + ahead < g.end()) {
+        _mm_prefetch(reinterpret_cast<const char*>(&stats.m[size_t(touched[t + ahead])]), _MM_HINT_T0);
+        _mm_prefetch(reinterpret_cast<const char*>(&regions.pair_parent[size_t(touched[t + ahead])]), _MM_HINT_T0);
+      }
+      if (hier && t + ahead / 2 < g.end()) {
+        int up = regions.pair_parent[size_t(touched[t + ahead / 2])];
+        if (up != invalid_id) _mm_prefetch(reinterpret_cast<const char*>(&stats.m[size_t(up)]), _MM_HINT_T0);
+      }
       size_t k = size_t(touched[t]);
       fold(k);
       // No children: a fine pair (its link is a sibling), or a coarse one whose fine regions do not exist yet.

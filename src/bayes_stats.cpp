@@ -44,63 +44,6 @@ void decay_stats(bayes_stats& s, double gamma) {
   }
 }
 
-pair_coeffs pair_coefficients(const pair_moments& m, const bayes_params& p) {
-  pair_coeffs_d c = pair_coefficients_d(m, p);
-  return {float(c.q2), float(c.q1), float(c.q0), float(c.qc), float(c.p1)};
-}
-
-pair_coeffs_d pair_coefficients_d(const pair_moments& m, const bayes_params& p) {
-  double n0 = m.n0, n1 = m.n1, z = m.mean, m2 = m.m2;
-  double n = n0 + n1;
-  double q2, q1 = 0, q0 = 0, qc = 0, p1;
-  if (!p.prior) {
-    // Naive plug-in moments; a pair without samples follows its bound (w = v).
-    if (n == 0) {
-      p1 = 1;
-      q2 = 1;  // second moment: sqrt(v^2) = v; mean only: v
-    } else {
-      p1 = n1 / n;
-      q2 = 0;
-      if (p.second_moment) q0 = z * z + (n1 >= 2 ? m2 / n1 : 0.0);
-      else q1 = z;
-    }
-  } else {
-    // p1 = E[1 - p0]; mu_n = A mu0 + B; h = C mu0^2 + D + E (z - mu0)^2 (see bayes_stats.h).
-    p1 = (p.b0 + n1) / (p.a0 + p.b0 + n);
-    double kn = p.kappa0 + n1;
-    double a = p.kappa0 / kn, b = n1 * z / kn;
-    if (!p.second_moment) {
-      q2 = a;
-      q1 = b;
-    } else {
-      double am1 = p.alpha0 + 0.5 * n1 - 1;
-      double c = p.c * (p.alpha0 - 1) / am1, d = 0.5 * m2 / am1, e = 0.5 * p.kappa0 * n1 / (kn * am1);
-      q2 = a * a + c + e;
-      q1 = 2 * a * b - 2 * e * z;
-      q0 = b * b + d + e * z * z;
-      qc = c;
-    }
-  }
-  return {q2, q1, q0, qc, p1};
-}
-
-bool pair_posterior(const bayes_stats& s, size_t i, const bayes_params& p, double mu0, double& k, double& h) {
-  double n1 = s.m[i].n1, z = s.m[i].mean, m2 = s.m[i].m2;
-  if (!p.prior) {
-    if (s.m[i].n0 + n1 == 0) return false;
-    k = z;
-    h = n1 >= 2 ? m2 / n1 : 0.0;
-    return true;
-  }
-  double kn = p.kappa0 + n1;
-  k = (p.kappa0 * mu0 + n1 * z) / kn;
-  double an = p.alpha0 + 0.5 * n1;
-  double dm = z - mu0;
-  double bn = p.c * mu0 * mu0 * (p.alpha0 - 1) + 0.5 * (m2 + p.kappa0 * n1 * dm * dm / kn);
-  h = bn / (an - 1);
-  return true;
-}
-
 void bayes_row::clear() {
   requests.clear();
   for (int h : used) slots[size_t(h)].first = -1;

@@ -1026,7 +1026,7 @@ TEST_CASE("control variates apply at unweighted NEE to nearly always visible clu
       // g: the point factor, 1 / d^2 times the orientation factor.
       double d = cluster_distance(t->tree, ctx->nodes[j], pt.p);
       double g = orientation_of(*t, s, ctx->nodes[j], pt.p, pt.n) / (d * d);
-      double p1 = pair_p1(s.stats, i, s.regions.pair_parent[i], s.params), k, h;
+      double p1 = pair_p1(s.stats, i, s.regions.pair_parent[i], s.params), k = 0, h = 0;
       bool learned = pair_posterior(s.stats, i, s.params, s.stats.mu0[i], k, h);
       bool cv = last && j == 0;
       CHECK((p1 >= s.params.cv_min_visible) == (j == 0));
