@@ -327,7 +327,6 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
   row.add_at(row.slot_at(ctx.rec_block, ctx.pair_base, j), z);
 }
 
-
 light_choice bayes_sampler::sample_members(const context& ctx, double u, double u_inner) const {
   if (ctx.count == 0 || !(ctx.cdf[ctx.count] > 0)) return {};
   int j = sample_cdf(ctx.cdf, ctx.count, u);

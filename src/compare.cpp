@@ -303,9 +303,8 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
                          : "- **mean curve**: the runs' relMSE and seconds averaged pass by pass.\n";
   s += "- **seconds**: render wall time (passes and learning), mean over runs; it excludes the setup column (light "
        "tree, regions) and error computation. Every pass is in curves.csv; error_vs_time.svg plots the mean curves.\n";
-  s += format("- **images**: `<sampler>.exr` is the render of run 1 (seed %llu), `<sampler>.png` the same as 8-bit sRGB "
-              "(clamped); `<sampler>_error.png` shows its "
-              "per-pixel relative error |x \xe2\x88\x92 r| / (|r| + 0.1), averaged over RGB, on the viridis ramp with "
+  s += format("- **images**: `<sampler>.exr` is the render of run 1 (seed %llu), `<sampler>.png` the same as 8-bit "
+              "sRGB (clamped); `<sampler>_error.png` shows its per-pixel relative error |x \xe2\x88\x92 r| / (|r| + 0.1), averaged over RGB, on the viridis ramp with "
               "the fixed logarithmic range %g (dark purple, and below) to %g (yellow, and above).\n",
               (unsigned long long)rp.seed, double(p.error_image.min_error), double(p.error_image.max_error));
   return s;
@@ -346,7 +345,8 @@ void write_comparison(const compare_data& data, const compare_params& p, const i
       // Interrupted before this sampler's first pass: images an earlier comparison left here would sit beside a
       // summary that lists none for it.
       std::error_code ec;
-      for (const std::string& f : {image_file(p, s.kind), png_file(p, s.kind), error_file(p, s.kind)}) fs::remove(f, ec);
+      for (const std::string& f : {image_file(p, s.kind), png_file(p, s.kind), error_file(p, s.kind)})
+        fs::remove(f, ec);
       continue;
     }
     failures.attempt([&] { write_image(image_file(p, s.kind), s.image); });

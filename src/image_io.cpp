@@ -268,10 +268,10 @@ static image_data read_exr(const std::string& path) {
     throw input_error(path, "malformed OpenEXR header: " + take_exr_error(err, "unknown error"));
   const EXRHeader& h = exr.header;
   int rgb[3] = {find_channel(h, "R"), find_channel(h, "G"), find_channel(h, "B")};
-  const std::vector<std::string> layers = rgb_layers(h);
-  if ((rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) && layers.size() == 1)
-    for (int c = 0; c < 3; ++c) rgb[c] = find_channel(h, (layers[0] + "." + "RGB"[c]).c_str());
   if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
+    const std::vector<std::string> layers = rgb_layers(h);
+    if (layers.size() == 1)
+      for (int c = 0; c < 3; ++c) rgb[c] = find_channel(h, (layers[0] + "." + "RGB"[c]).c_str());
     if (layers.size() > 1) {
       std::string names;
       for (size_t i = 0; i < layers.size() && i < 8; ++i) names += (i ? ", " : "") + layers[i];
@@ -279,6 +279,8 @@ static image_data read_exr(const std::string& path) {
                                   names + (layers.size() > 8 ? ", ..." : "") +
                                   "): which is the image is not clear; save that layer alone");
     }
+  }
+  if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) {
     if (find_channel(h, "RY") >= 0 || find_channel(h, "BY") >= 0)
       throw input_error(path, "luminance/chroma OpenEXR files (Y, RY, BY) are not supported (write R, G, B)");
     if (find_channel(h, "X") >= 0 && find_channel(h, "Z") >= 0)

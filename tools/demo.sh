@@ -25,7 +25,9 @@ echo "rendering $scene with the bound and the bayes sampler for $T s each"
 echo
 echo "error against time (relMSE vs the reference at $T s; every pass in $out/curves.csv):"
 # The table's rows: sampler, spp, seconds, relMSE at T, speed-up over bound at equal time.
-awk -F'|' '$2 ~ /^ (bound|bayes) $/ {for (i = 2; i <= 6; i++) gsub(/ /, "", $i); printf "  %-6s %5d spp in %6.2f s  relMSE %s  speed-up over bound %sx\n", $2, $3, $4, $5, $6}' \
-  "$out/summary.md"
+awk -F'|' '$2 ~ /^ (bound|bayes) $/ {
+  for (i = 2; i <= 6; i++) gsub(/ /, "", $i)
+  printf "  %-6s %5d spp in %6.2f s  relMSE %s  speed-up over bound %sx\n", $2, $3, $4, $5, $6
+}' "$out/summary.md"
 echo "report: $out/summary.md, plot: $out/error_vs_time.svg"
 echo "images: $out/bayes.png (.exr), $out/bound.png (.exr); error images: $out/bayes_error.png, $out/bound_error.png"
