@@ -380,7 +380,8 @@ void resume_render(const render_options& o, const render_params& params, const s
   if (sampler_adapts(s) && off > 0 && (params.time_budget > 0 ? !budget_spent : params.spp > r.spp))
     std::fprintf(stderr,
                  "%s: warning: its pass ending at %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 "
-                 "... do): the continued image is correct, but not bit-identical to one render of the final spp\n",
+                 "... do; a --time render cuts its last pass to the time left): the continued image is correct, but not "
+                 "bit-identical to one render of the final spp\n",
                  o.resume.c_str(), off);
 }
 

@@ -16,7 +16,7 @@ namespace {
 void add_render_options(CLI::App* r, render_options& o) {
   auto* spp = r->add_option("--spp", o.spp, "Samples per pixel (default: the scene's render.spp)")
                   ->check(CLI::Range(1, INT_MAX));
-  auto* time = r->add_option("--time", o.time, "Render whole passes until this many seconds are spent")
+  auto* time = r->add_option("--time", o.time, "Render passes until this many seconds are spent (the last one cut to the time left)")
                    ->check(CLI::Range(1e-6, 1e9))->check(finite_number);
   spp->excludes(time);
   r->add_option("--max-depth", o.max_depth,
@@ -230,7 +230,7 @@ void add_compare_command(CLI::App& app, compare_options& o) {
   add_render_options(c, o.render);
   // (compare has no scene default: every sampler renders the same given budget)
   c->get_option("--spp")->description("Samples per pixel of every render (this or --time is required)");
-  c->get_option("--time")->description("Seconds per render, whole passes (this or --spp is required)");
+  c->get_option("--time")->description("Seconds per render, the last pass cut to the time left (this or --spp is required)");
 }
 
 }  // namespace bl

@@ -13,6 +13,7 @@
 #include <cerrno>
 #include <chrono>
 #include <climits>
+#include <cmath>
 #include <csignal>
 #include <ctime>
 #include <pthread.h>
@@ -288,6 +289,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
 
   const int target = params.time_budget > 0 ? INT_MAX : params.spp;
   int done = result.spp;
+  double seconds_per_spp = 0;  // of the last pass, with the learning and the checkpoint after it (0: none yet)
   progress.spp_done = done;
   for (int pass = result.passes; done < target; pass++) {
     if (params.time_budget > 0 && result.seconds >= params.time_budget) break;
@@ -303,6 +305,17 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     }
     g_first_pass.store(first);
     int count = std::min(pass_size(pass, done, int64_t(in.camera.width) * in.camera.height), target - done);
+    // The last pass of a --time render takes only what fits the time left: passes grow by a quarter of the spp so
+    // far, and a whole one started just before the budget ran a render up to a quarter past it. A cut pass ends the
+    // render even where it ends before the budget (the machine sped up): a --spp render of the same total cuts its
+    // last pass at the same place, and only there, so the two stay the same image.
+    bool cut = false;
+    if (params.time_budget > 0) {
+      const int fitted = fit_pass_to_time(count, params.time_budget - result.seconds, seconds_per_spp);
+      cut = fitted < count;
+      count = fitted;
+    }
+    const double cycle_start = result.seconds;
     progress.pass = pass + 1;
     progress.pass_spp = count;
     progress.rows_done = 0;
@@ -373,7 +386,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     result.log.push_back(rec);
     // Not after the last pass (the render's end, where the caller writes its final checkpoint anyway: a second
     // copy of it, counted in the render's seconds, made the summary disagree with the log's last row; a review).
-    const bool last_pass = done >= target || (params.time_budget > 0 && result.seconds >= params.time_budget);
+    const bool last_pass = done >= target || (params.time_budget > 0 && result.seconds >= params.time_budget) || cut;
     if (after_pass && !last_pass) {
       // What the caller does between passes (a checkpoint: seconds for a large render) is render time too: the next
       // pass's seconds, the --time budget and the summary count it (the error computation above they do not).
@@ -381,6 +394,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
       after_pass();
       result.seconds += seconds_since(ta);
     }
+    seconds_per_spp = (result.seconds - cycle_start) / count;
+    if (cut) break;
   }
 }
 
@@ -402,6 +417,13 @@ bool ends_scheduled_pass(int spp, int64_t pixels) {
   int64_t done = 0;
   for (int pass = 0; done < spp; pass++) done += pass_size(pass, int(done), pixels);
   return done == spp;
+}
+
+int fit_pass_to_time(int count, double left, double seconds_per_spp) {
+  if (count <= 1 || !(seconds_per_spp > 0) || !(left > 0)) return count;
+  // (A tenth more than the last pass's speed says: a pass that ends short of the budget ends the render there.)
+  const double fits = std::ceil(1.1 * left / seconds_per_spp);
+  return fits < double(count) ? std::max(1, int(fits)) : count;
 }
 
 bool sampler_adapts(const light_sampler& s) {

@@ -25,7 +25,7 @@ struct render_result;
 struct render_params {
   int width = 640, height = 480;
   int spp = 64;               // target samples per pixel (ignored when time_budget > 0)
-  double time_budget = 0;     // seconds; > 0: render whole passes until this much wall time is spent
+  double time_budget = 0;     // seconds; > 0: render passes until this much wall time is spent (fit_pass_to_time)
   int max_depth = 5;
   uint64_t seed = 0;
   int threads = 0;            // 0: all cores
@@ -99,6 +99,12 @@ int pass_size(int pass, int done, int64_t pixels);
 // Whether `spp` ends a pass of the untruncated schedule (pass_size from 0): a render stopped there and continued
 // takes the same passes as one render of more spp.
 bool ends_scheduled_pass(int spp, int64_t pixels);
+// Samples per pixel of the next pass of a --time render with `left` seconds of its budget left: `count` (its
+// scheduled size), or fewer where the last pass's `seconds_per_spp` (its learning and what followed it included)
+// says fewer fill the time left (a tenth more, rounded up, so that the pass ends past the budget unless the machine
+// speeds up; at least 1). Where it cuts, that pass is the render's last.
+// Without a speed (0: no pass timed yet): `count`.
+int fit_pass_to_time(int count, double left, double seconds_per_spp);
 // Weight of the samples of a pass that starts after `done` spp: (done + 1) / (done + 1 + s), 1 for s = 0.
 double pass_weight(int done, double s);
 // Whether the sampler's passes are weighted by pass_weight (an adaptive sampler that still learns).

@@ -220,3 +220,46 @@ TEST_CASE("weighting the first passes lowers bayes's error where the prior is po
   INFO("mean gain " << m.mean << " +- " << m.se);
   CHECK(m.mean > 3.7 * m.se);
 }
+
+TEST_CASE("a --time render's last pass takes what the last pass's speed says fits the time left", "[passes]") {
+  CHECK(fit_pass_to_time(8, 0.35, 0.1) == 4);   // 1.1 × 3.5 = 3.85, rounded up
+  CHECK(fit_pass_to_time(8, 0.01, 0.1) == 1);   // at least 1
+  CHECK(fit_pass_to_time(8, 5.0, 0.1) == 8);    // the whole pass fits: as scheduled
+  CHECK(fit_pass_to_time(8, 0.72, 0.1) == 8);   // 7.92 rounds up to the whole pass
+  CHECK(fit_pass_to_time(8, 0.7, 0.1) == 8);    // 7.7: 8
+  CHECK(fit_pass_to_time(8, 0.6, 0.1) == 7);    // 6.6: 7
+  CHECK(fit_pass_to_time(1, 0.001, 0.1) == 1);
+  CHECK(fit_pass_to_time(8, 0.35, 0.0) == 8);   // no pass timed yet
+  CHECK(fit_pass_to_time(8, 1e300, 1e-300) == 8);  // (no overflow into int)
+  CHECK(fit_pass_to_time(64, 1e-9, 1e300) == 1);
+}
+
+TEST_CASE("a --time render ends with a pass cut to the budget, the image of the --spp render of its total",
+          "[passes]") {
+  // A whole pass started just before the budget ran a render up to a quarter past it. Here every pass is followed by
+  // a sleep of 50 ms per spp it took (a lower bound on the time, whatever the load): with a budget of 1.7 s the
+  // passes of 1, ..., 1, 2, 2, 3, 3, 4, 5, 6 spp end after 33 spp at 1.65 s or later, and the next scheduled pass (8
+  // spp) would end at 2.05 s or later, 41 spp. Cut to the time left (at least 50 ms per spp), the render ends at 35
+  // spp or fewer, whatever the machine's speed.
+  auto b = boxed_lamp_scene();
+  render_params p = small_params(sampler_kind::bayes, 1, 4);
+  p.time_budget = 1.7;
+  p.on_pass = [&](const render_result& r, const light_sampler&, bool last) {
+    if (last) return;
+    const int took = r.log.back().spp - (r.log.size() > 1 ? r.log[r.log.size() - 2].spp : 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50 * took));
+  };
+  render_result r = render(b->scene, b->bvh, b->lights, p);
+  INFO("spp " << r.spp << ", seconds " << r.seconds);
+  CHECK(r.spp <= 35);
+  // Cut, or (on a machine so loaded that a pass boundary came after the budget) a whole pass that spent it.
+  REQUIRE(r.log.size() >= 2);
+  const int last = r.log.back().spp - r.log[r.log.size() - 2].spp;
+  const bool cut = last < pass_size(int(r.log.size()) - 1, r.log[r.log.size() - 2].spp, int64_t(p.width) * p.height);
+  CHECK((cut || r.seconds >= p.time_budget));
+  // The --spp render of the same total: the same passes, the last cut at the same place.
+  render_params q = small_params(sampler_kind::bayes, r.spp, 4);
+  render_result s = render(b->scene, b->bvh, b->lights, q);
+  CHECK(s.passes == r.passes);
+  CHECK(s.film == r.film);
+}
