@@ -686,6 +686,7 @@ int run_cli(int argc, char** argv) {
       "  bayeslight render scene.json -o out.exr --spp 256\n"
       "  bayeslight render scene.json --time 10 --reference ref.exr --log log.csv -o out.png\n"
       "  bayeslight compare scene.json --reference ref.exr --time 10 --samplers bound,bayes --out cmp\n"
+      "  bayeslight profile scene.json --sampler bayes --time 10\n"
       "  bayeslight diff out.exr ref.exr\n"
       "Each command's options: bayeslight COMMAND --help. The version and build: bayeslight --version.\n"
       "Exit status: 0 success; 1 other failure (e.g. an output that cannot be written); 2 bad command line; 3 bad "

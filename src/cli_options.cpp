@@ -16,7 +16,9 @@ namespace {
 void add_render_options(CLI::App* r, render_options& o) {
   auto* spp = r->add_option("--spp", o.spp, "Samples per pixel (default: the scene's render.spp)")
                   ->check(CLI::Range(1, INT_MAX));
-  auto* time = r->add_option("--time", o.time, "Render passes until this many seconds are spent (the last one cut to the time left)")
+  auto* time = r->add_option("--time", o.time,
+                             "Render passes until this many seconds are spent (the last one cut to the spp that fit "
+                             "the time left, so a render ends near it)")
                    ->check(CLI::Range(1e-6, 1e9))->check(finite_number);
   spp->excludes(time);
   r->add_option("--max-depth", o.max_depth,
@@ -40,7 +42,8 @@ void add_render_options(CLI::App* r, render_options& o) {
           throw CLI::ValidationError("--seed", "must be an integer from 0 to 18446744073709551615 (got " + s + ")");
         o.seed = uint64_t(v), o.has_seed = true;
       },
-      "Random seed, 0 to 2^64 - 1 (default: the scene's render.seed)");
+      "Random seed, 0 to 2^64 - 1 (default: the scene's render.seed)")
+      ->type_name("UINT");
   r->add_option("--width", o.width, "Image width in pixels (default: the scene's image.width; at most 2^28 pixels in all)")
       ->check(CLI::Range(1ll, max_side));
   r->add_option("--height", o.height, "Image height in pixels (default: the scene's image.height; at most 2^28 pixels in all)")
@@ -127,9 +130,10 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--bayes-kappa0", o.bayes.kappa0, "Prior pseudo-count of the mean k (1e-6 to 1e6, default 1)")
       ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);
   r->add_option("--bayes-alpha0", o.bayes.alpha0, "Inverse-gamma shape of the variance h (1.000001 to 1e9, default 2)")
-      ->check(CLI::Range(1.000001, 1e9).description("FLOAT in [1.000001 - 1e9]"))->check(finite_number)->group(bg);
+      ->check(CLI::Range(1.000001, 1e9).description("FLOAT in [1.000001 - 1e+09]"))->check(finite_number)->group(bg);
   r->add_option("--bayes-oracle", o.bayes.oracle_spp,
-                "Oracle mode: learn for this many spp first (own seed, not timed), then freeze the statistics")
+                "Oracle mode: learn for this many spp first (own seed, not timed), then freeze the statistics "
+                "(default 0: off)")
       ->check(CLI::Range(0, 1 << 30))->group(bg);
   r->add_option("--bayes-hierarchy", o.bayes.hierarchy,
                 "Concentration of a fine region's Beta prior on p0, centred on its coarse parent's posterior (0 = off, default 1)")
@@ -157,18 +161,21 @@ void add_render_command(CLI::App& app, render_options& o) {
   // One file per -o (a vector option would otherwise also take the scene after it: `render -o a.exr SCENE`).
   r->add_option("-o,--output", o.outputs,
                 ".exr/.pfm (linear float RGB) or .png (8-bit sRGB, clamped); repeatable, one file each (default: "
-                "SCENE's name with .exr, in the current directory)")
+                "SCENE's name with .exr for its extension, in the current directory: scene.json gives scene.exr)")
       ->allow_extra_args(false)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   r->add_option("--reference", o.reference,
                 "Reference .exr/.pfm of the same size: error after every pass (in --log), the final one in the "
                 "summary line")
       ->check(file_name);
-  r->add_option("--log", o.log, "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse")->check(file_name);
+  r->add_option("--log", o.log,
+                "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse (relmse and mse empty without --reference)")
+      ->check(file_name);
   r->add_option("--frames", o.frames,
                 "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
-                "and --reference then take a frame pattern such as out_%04d.exr (default output SCENE_%04d.exr; "
-                "without --frames names are literal; with --checkpoint, --resume continues at the frame under way)")
+                "and --reference then take a frame pattern such as out_%04d.exr (default output: SCENE's name with "
+                "_%04d.exr, e.g. scene_0000.exr; without --frames names are literal; with --checkpoint, --resume "
+                "continues at the frame under way)")
       ->check(CLI::Range(1, 100000));
   r->add_option("--checkpoint", o.checkpoint,
                 "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
