@@ -291,8 +291,9 @@ void check_distinct_outputs(const std::vector<std::pair<std::string, std::string
                           in.first);
     for (size_t j = 0; j < i; j++)
       if (same_file(outputs[i].first, outputs[j].first))
-        throw usage_error(outputs[i].second + " " + outputs[i].first + " is also the " + outputs[j].second + " " +
-                          outputs[j].first);
+        throw usage_error(outputs[i].second + " " + outputs[i].first +
+                          (outputs[i] == outputs[j] ? std::string(" is given twice")
+                                                    : " is also the " + outputs[j].second + " " + outputs[j].first));
   }
 }
 

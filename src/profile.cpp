@@ -137,7 +137,8 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
     out += buf;
   };
   line("profile of %s\n", title.c_str());
-  line("  %dx%d, %d spp, max depth %d, %d threads", params.width, params.height, a.spp, params.max_depth, threads);
+  line("  %dx%d, %d spp, max depth %d, %d thread%s", params.width, params.height, a.spp, params.max_depth, threads,
+       threads == 1 ? "" : "s");
   if (params.light_samples > 1) line(", %d light samples per vertex", params.light_samples);
   line("\n");
   double rays_total = double(st.camera_rays + st.shadow_rays + st.bounce_rays);
@@ -179,8 +180,8 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
            lp.refold / std::max(lp.refolds, 1.0) * 1e9);
   }
   line("  %-44s %10.1f %7.1f%%\n", "total", b.seconds / nee_b * 1e9, 100.0);
-  line("\n  raw Embree rtcOccluded1 on this scene: %.2f M rays/s (%zu rays, %d threads)\n", limit * 1e-6,
-       rays.org.size(), threads);
+  line("\n  raw Embree rtcOccluded1 on this scene: %.2f M rays/s (%zu rays, %d thread%s)\n", limit * 1e-6,
+       rays.org.size(), threads, threads == 1 ? "" : "s");
   if (limit > 0) {
     line("  render NEE samples/s as a fraction of the raw shadow-ray limit: %.3f\n", nee / a.seconds / limit);
     // Why the fraction is below 1: what else a NEE sample pays for, from the timed render's stages.

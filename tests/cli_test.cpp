@@ -664,6 +664,8 @@ TEST_CASE("outputs that would overwrite an input or each other are refused befor
       {sc + " --reference " + (s.dir / "ref.pfm") + " -o " + (s.dir / "sub/../ref.pfm"), "would overwrite the reference"},
       {sc + " -o " + (s.dir / "a.pfm") + " --checkpoint " + (s.dir / "./a.pfm"), "is also the output"},
       {sc + " --checkpoint " + (s.dir / "run.csv") + " --log " + (s.dir / "sub/../run.csv"), "is also the"},
+      // (The same name twice said "output X is also the output X"; a review.)
+      {sc + " -o " + (s.dir / "z.pfm") + " -o " + (s.dir / "z.pfm"), "output " + (s.dir / "z.pfm") + " is given twice"},
       // (A log named .obj, .mtl, .json or like an image is refused by its name: bad command lines.)
   };
   std::filesystem::create_directory(s.dir / "sub");
@@ -1453,6 +1455,8 @@ TEST_CASE("a profile of a scene without NEE samples gives its stages per camera 
   CHECK(r.output.find("stages below per camera ray of it (the render took no NEE sample)") != std::string::npos);
   CHECK(r.output.find("ns/ray") != std::string::npos);
   CHECK(r.output.find("ns/NEE") == std::string::npos);
+  CHECK(r.output.find("8x8, 2 spp, max depth 5, 1 thread\n") != std::string::npos);  // (it said "1 threads")
+  CHECK(r.output.find(" rays, 1 thread)") != std::string::npos);
 }
 
 TEST_CASE("a profile counts the camera rays each NEE sample pays for", "[cli]") {

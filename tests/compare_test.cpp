@@ -336,6 +336,7 @@ TEST_CASE("compare names the images an earlier comparison left in its folder", "
   CHECK(r.output.find("compare: warning: " + out + " also holds power.exr, power.png, power_error.png from an earlier "
                       "comparison (not part of this one)") != std::string::npos);
   CHECK(std::filesystem::exists(out + "/power.exr"));
+  CHECK(slurp(out + "/summary.md").find(" | 1 thread\n") != std::string::npos);  // (it said "1 threads")
   r = run_bayeslight(args + " --samplers power,bvh,uniform");
   CHECK(r.output.find("warning") == std::string::npos);
 }
