@@ -171,10 +171,12 @@ constexpr int rows_per_band() {
 }
 
 // Renders samples [s0, s1) of every pixel into pass_sum; false when interrupted (the pass is then void). With
-// Profile, each row's stages are timed into rows.timers.
+// Profile, each row's stages are timed into rows.timers. extend: the samples go on from a run of the same pass
+// that ended at s0 (its sums, counters, timers and records are added to, not restarted).
 template <bool Profile, class Sampler, class Rows>
 bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, std::vector<double>& pass_sum,
-              Rows& rows, tbb::task_arena& arena, progress_counters& progress, int raise_signals = 0) {
+              Rows& rows, tbb::task_arena& arena, progress_counters& progress, int raise_signals = 0,
+              bool extend = false) {
   int w = in.camera.width, h = in.camera.height;
   std::atomic<bool> stopped{false};
   // Work items are bands of rows (one row for samplers without a row state shared by several rows): a band's rows
@@ -191,21 +193,25 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
               return;
             }
             path_stats& st = rows.stats[size_t(y)];
-            st = {};
+            if (!extend) st = {};
             typename Sampler::context ctxs[2];
             std::conditional_t<Profile, cycle_timers, no_timers> tm;
             for (int x = 0; x < w; x++) {
-              double sum[3] = {0, 0, 0};
+              double* out = &pass_sum[3 * (size_t(y) * w + x)];
+              // (Extended: the sums go on from the pass's earlier samples, added in the order one pass adds them.)
+              double sum[3] = {extend ? out[0] : 0.0, extend ? out[1] : 0.0, extend ? out[2] : 0.0};
               const pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * w + x));
               for (int s = s0; s < s1; s++) {
                 vec3f l = trace_path_timed(in, sampler, x, y, ps, uint64_t(s), st, sink, ctxs, tm);
                 sink.sample_done(y * w + x, l);
                 sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
               }
-              double* out = &pass_sum[3 * (size_t(y) * w + x)];
               out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
             }
-            if constexpr (Profile) rows.timers[size_t(y)] = tm;
+            if constexpr (Profile) {
+              if (!extend) rows.timers[size_t(y)] = {};
+              for (int c = 0; c < prof_count; c++) rows.timers[size_t(y)].cycles[c] += tm.cycles[c];
+            }
             if (progress.rows_done.fetch_add(1, std::memory_order_relaxed) == 0)  // (testing)
               for (int k = 0; k < std::abs(raise_signals); k++) {
                 if (k > 0 && raise_signals < 0) std::this_thread::sleep_for(std::chrono::milliseconds(600));
@@ -215,7 +221,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
         };
         if constexpr (Sampler::learns) {
           auto& state = rows.records[size_t(b)];
-          state.clear();
+          if (!extend) state.clear();
           row_sink<Sampler> sink{&sampler, &state};
           render_band(sink);
         } else {
@@ -306,15 +312,11 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     g_first_pass.store(first);
     int count = std::min(pass_size(pass, done, int64_t(in.camera.width) * in.camera.height), target - done);
     // The last pass of a --time render takes only what fits the time left: passes grow by a quarter of the spp so
-    // far, and a whole one started just before the budget ran a render up to a quarter past it. A cut pass ends the
-    // render even where it ends before the budget (the machine sped up): a --spp render of the same total cuts its
-    // last pass at the same place, and only there, so the two stay the same image.
-    bool cut = false;
-    if (params.time_budget > 0) {
-      const int fitted = fit_pass_to_time(count, params.time_budget - result.seconds, seconds_per_spp);
-      cut = fitted < count;
-      count = fitted;
-    }
+    // far, and a whole one started just before the budget ran a render up to a quarter past it. A cut pass is the
+    // render's last: a --spp render of the same total cuts its last pass at the same place, and only there, so the
+    // two stay the same image. (Where it ends before the budget, it goes on below with more of its samples.)
+    const int scheduled = count;
+    if (params.time_budget > 0) count = fit_pass_to_time(count, params.time_budget - result.seconds, seconds_per_spp);
     const double cycle_start = result.seconds;
     progress.pass = pass + 1;
     progress.pass_spp = count;
@@ -327,15 +329,32 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     render_inputs pin = in;
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
-    const int raise = pass == 0 && done == 0 ? params.signals_in_first_pass : 0;
-    auto run = [&](const auto& s) {
-      return params.profile ? run_pass<true>(pin, s, done, done + count, pass_sum, rows, arena, progress, raise)
-                            : run_pass<false>(pin, s, done, done + count, pass_sum, rows, arena, progress, raise);
+    int raise = pass == 0 && done == 0 ? params.signals_in_first_pass : 0;
+    auto run_samples = [&](int s0, int s1, bool extend) {
+      if (params.on_samples) params.on_samples(s1 - s0);
+      auto run = [&](const auto& s) {
+        return params.profile ? run_pass<true>(pin, s, s0, s1, pass_sum, rows, arena, progress, raise, extend)
+                              : run_pass<false>(pin, s, s0, s1, pass_sum, rows, arena, progress, raise, extend);
+      };
+      // A bayes sampler that fell back runs its passes as the power sampler itself: the hot path has none of its
+      // code.
+      if constexpr (std::is_same_v<Sampler, bayes_sampler>) return sampler.fallback ? run(sampler.power) : run(sampler);
+      else return run(sampler);
     };
-    bool complete;
-    // A bayes sampler that fell back runs its passes as the power sampler itself: the hot path has none of its code.
-    if constexpr (std::is_same_v<Sampler, bayes_sampler>) complete = sampler.fallback ? run(sampler.power) : run(sampler);
-    else complete = run(sampler);
+    bool complete = run_samples(done, done + count, false);
+    // A cut pass that ends before the budget (the machine sped up) goes on with more of its samples, from the same
+    // model and sums: still one pass, the --spp render's of its total, that ends at or past the budget, and never
+    // longer than the scheduled one.
+    raise = 0;
+    while (complete && count < scheduled && result.seconds + seconds_since(t0) < params.time_budget) {
+      const double elapsed = seconds_since(t0);
+      const int more = fit_pass_to_time(scheduled - count, params.time_budget - result.seconds - elapsed, elapsed / count);
+      progress.pass_spp = count + more;
+      progress.rows_done = 0;
+      complete = run_samples(done + count, done + count + more, true);
+      count += more;
+    }
+    const bool cut = count < scheduled;
     g_first_pass.store(false);
     // A signal the first pass finished for ends the render after it, even where that pass was the last (an animation
     // then stops after this frame; before, it went on to the next frame's first pass).

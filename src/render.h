@@ -55,6 +55,7 @@ struct render_params {
   // Called after every completed pass (last = false) and once when the render ends (last = true), with the state
   // of the completed passes: what a checkpoint saves.
   std::function<void(const render_result&, const light_sampler&, bool last)> on_pass;
+  std::function<void(int spp)> on_samples;  // testing: called as a pass starts its samples (and as a cut one goes on)
   // Called once the sampler is built, before the first pass: restores a checkpointed state (resume).
   std::function<void(render_result&, light_sampler&)> restore;
 };
@@ -102,7 +103,8 @@ bool ends_scheduled_pass(int spp, int64_t pixels);
 // Samples per pixel of the next pass of a --time render with `left` seconds of its budget left: `count` (its
 // scheduled size), or fewer where the last pass's `seconds_per_spp` (its learning and what followed it included)
 // says fewer fill the time left (a tenth more, rounded up, so that the pass ends past the budget unless the machine
-// speeds up; at least 1). Where it cuts, that pass is the render's last.
+// speeds up; at least 1). Where it cuts, that pass is the render's last; where it then ends before the budget, it goes
+// on with more of its samples (the same model and sums), sized alike from its own speed so far.
 // Without a speed (0: no pass timed yet): `count`.
 int fit_pass_to_time(int count, double left, double seconds_per_spp);
 // Weight of the samples of a pass that starts after `done` spp: (done + 1) / (done + 1 + s), 1 for s = 0.
