@@ -237,7 +237,8 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
   s += p.runs == 1 ? format("1 run (seed %llu)", (unsigned long long)rp.seed)
                    : format("%d runs (seeds %llu to %llu%s)", p.runs, (unsigned long long)rp.seed,
                             (unsigned long long)last_seed, last_seed < rp.seed ? ", wrapping past 2^64 - 1 to 0" : "");
-  s += rp.threads > 0 ? format(" | %d thread%s\n\n", rp.threads, rp.threads == 1 ? "" : "s") : std::string(" | threads: all cores\n\n");
+  s += rp.threads > 0 ? format(" | %d thread%s\n\n", rp.threads, rp.threads == 1 ? "" : "s")
+                      : std::string(" | threads: all cores\n\n");
   s += (p.reference_note.empty() ? "reference: " + p.reference_path : p.reference_note) + "\n\n";
   const double t_cmp = comparison_time(data);
   if (data.signal != 0) {
@@ -281,17 +282,16 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
 
   s += "\n- **relMSE**: mean over pixels and RGB channels of (x \xe2\x88\x92 r)\xc2\xb2 / (r\xc2\xb2 + 0.01) ";
   s += data.equal_time ? "at exactly the comparison time (log-log between the last pass before it and the first at or "
-                         "after it; the last pass's where a run ended just before it; spp and seconds are the final "
-                         "pass's)"
+                         "after it; spp and seconds are the final pass's)"
                        : "after the final pass";
   s += p.runs > 1 ? format("; mean \xc2\xb1 standard deviation over the %d runs.\n", p.runs) : std::string(".\n");
   if (data.equal_time)
-    s += "- **image relMSE**: the error of `<sampler>.exr`, run 1's render after its last pass (cut to end near the budget).\n";
+    s += "- **image relMSE**: the error of `<sampler>.exr`, run 1's render after its last pass (cut to end just past "
+         "the budget).\n";
   if (data.equal_time)
     s += "- **speed-up** at equal time: relMSE of " + base + " / relMSE of the sampler, both at the time budget "
          "(each render's last pass is cut to the time left, to end just past it; its error at the budget is "
-         "interpolated), "
-         "or where a signal cut the renders short, at the end of the shortest run.\n";
+         "interpolated), or where a signal cut the renders short, at the end of the shortest run.\n";
   else
     s += "- **speed-up** at equal spp: the efficiency ratio (relMSE \xc3\x97 seconds of " + base +
          ") / (relMSE \xc3\x97 seconds of the sampler), which is the equal-time speed-up when relMSE falls as "
