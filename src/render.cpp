@@ -349,8 +349,11 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     while (complete && count < scheduled && result.seconds + seconds_since(t0) < params.time_budget) {
       const double elapsed = seconds_since(t0);
       const int more = fit_pass_to_time(scheduled - count, params.time_budget - result.seconds - elapsed, elapsed / count);
-      progress.pass_spp = count + more;
+      progress.spp_done = done + count;  // (the bar's running pass: this piece, from its start)
+      progress.pass_spp = more;
       progress.rows_done = 0;
+      progress.pass_start_ns =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(clock_type::now().time_since_epoch()).count();
       complete = run_samples(done + count, done + count + more, true);
       count += more;
     }
