@@ -296,6 +296,12 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   const int target = params.time_budget > 0 ? INT_MAX : params.spp;
   int done = result.spp;
   double seconds_per_spp = 0;  // of the last pass, with the learning and the checkpoint after it (0: none yet)
+  if (!result.log.empty()) {  // (a resumed render: its checkpoint's last pass)
+    const size_t n = result.log.size();
+    const double t0 = n > 1 ? result.log[n - 2].seconds : 0.0;
+    const int s0 = n > 1 ? result.log[n - 2].spp : 0;
+    if (result.log[n - 1].spp > s0) seconds_per_spp = (result.log[n - 1].seconds - t0) / (result.log[n - 1].spp - s0);
+  }
   progress.spp_done = done;
   for (int pass = result.passes; done < target; pass++) {
     if (params.time_budget > 0 && result.seconds >= params.time_budget) break;
