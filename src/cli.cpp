@@ -700,8 +700,8 @@ int run_cli(int argc, char** argv) {
   render_options popt;
   add_profile_command(app, popt);
   CLI::App* diff = app.add_subcommand("diff", "Compare two images: relmse, mse, maxabs; 'identical' if bit-equal");
-  diff->add_option("A", dopt.a, "Image (.exr/.pfm)")->required();
-  diff->add_option("B", dopt.b, "Image (.exr/.pfm), the reference")->required();
+  diff->add_option("A", dopt.a, "Image (.exr/.pfm)")->required()->type_name("FILE");
+  diff->add_option("B", dopt.b, "Image (.exr/.pfm), the reference")->required()->type_name("FILE");
   std::string first = argc >= 2 ? argv[1] : "";
   if (argc == 2 && (first == "--version" || first == "-V")) {
     print_version();

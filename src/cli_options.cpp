@@ -156,21 +156,23 @@ void add_render_options(CLI::App* r, render_options& o) {
 
 void add_render_command(CLI::App& app, render_options& o) {
   CLI::App* r = app.add_subcommand("render", "Render a scene (.json scene file or bare .obj)");
-  r->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required();
-  r->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)");
+  r->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required()->type_name("FILE");
+  r->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)")
+      ->type_name("NAME");
   // One file per -o (a vector option would otherwise also take the scene after it: `render -o a.exr SCENE`).
   r->add_option("-o,--output", o.outputs,
                 ".exr/.pfm (linear float RGB) or .png (8-bit sRGB, clamped); repeatable, one file each (default: "
                 "SCENE's name with .exr for its extension, in the current directory: scene.json gives scene.exr)")
       ->allow_extra_args(false)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->type_name("FILE");
   r->add_option("--reference", o.reference,
                 "Reference .exr/.pfm of the same size: error after every pass (in --log), the final one in the "
                 "summary line")
-      ->check(file_name);
+      ->type_name("FILE")->check(file_name);
   r->add_option("--log", o.log,
                 "Per-pass CSV: sampler,pass,spp,seconds,relmse,mse (relmse and mse empty without --reference)")
-      ->check(file_name);
+      ->type_name("FILE")->check(file_name);
   r->add_option("--frames", o.frames,
                 "Render an animation of N frames: the sun moves from sun.direction to sun.direction_end; -o, --log "
                 "and --reference then take a frame pattern such as out_%04d.exr (default output: SCENE's name with "
@@ -180,14 +182,14 @@ void add_render_command(CLI::App& app, render_options& o) {
   r->add_option("--checkpoint", o.checkpoint,
                 "Save the render state to FILE between passes (at most every --checkpoint-every s, on SIGINT/SIGTERM, "
                 "and at the end); --resume continues it")
-      ->check(file_name);
+      ->type_name("FILE")->check(file_name);
   r->add_option("--checkpoint-every", o.checkpoint_every, "Seconds between checkpoints (default 30; 0: every pass)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number);
   r->add_option("--resume", o.resume,
                 "Continue the render saved in FILE (same scene and options; --spp may be larger: the same bytes as one render "
                 "of that many spp when the saved spp ended a scheduled pass, e.g. 8 10 12 15 18 22 27 33 ...); its spp, "
                 "seconds and --time budget count the saved ones")
-      ->check(file_name);
+      ->type_name("FILE")->check(file_name);
   r->add_flag("--signal-after-last-pass", o.signal_after_last_pass,
               "testing: raise SIGINT once the last pass is done, before the outputs are written")
       ->group("");
@@ -214,8 +216,9 @@ void add_render_command(CLI::App& app, render_options& o) {
 void add_profile_command(CLI::App& app, render_options& o) {
   CLI::App* p = app.add_subcommand("profile", "Time the stages of a render (ns per NEE sample) against the raw "
                                               "Embree shadow-ray limit on the same scene");
-  p->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required();
-  p->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)");
+  p->add_option("SCENE", o.scene, "Scene file (.json) or mesh (.obj)")->required()->type_name("FILE");
+  p->add_option("--sampler", o.sampler, "Light selection for NEE: " + sampler_names() + " (default bayes)")
+      ->type_name("NAME");
   add_render_options(p, o);
 }
 
@@ -224,14 +227,16 @@ void add_profile_command(CLI::App& app, render_options& o) {
 void add_compare_command(CLI::App& app, compare_options& o) {
   CLI::App* c = app.add_subcommand("compare", "Render several samplers for the same time (or spp) against a "
                                               "reference: curves.csv, error_vs_time.svg, summary.md, images");
-  c->add_option("SCENE", o.render.scene, "Scene file (.json) or mesh (.obj)")->required();
+  c->add_option("SCENE", o.render.scene, "Scene file (.json) or mesh (.obj)")->required()->type_name("FILE");
   c->add_option("--reference", o.render.reference, "Reference .exr/.pfm of the render's size")
       ->required()
+      ->type_name("FILE")
       ->check(file_name);
   // (One string, split here: a vector option would show as "TEXT ..." in the help, as if it took several words.)
   c->add_option("--samplers", o.samplers, "Comma-separated samplers, the first is the baseline: " + sampler_names())
       ->required()->type_name("NAME,NAME,...");
-  c->add_option("--out", o.out, "Output directory (created if missing)")->required()->check(file_name);
+  c->add_option("--out", o.out, "Output directory (created if missing)")
+      ->required()->type_name("DIR")->check(file_name);
   c->add_option("--runs", o.runs, "Runs per sampler, seeds base, base+1, ... (default 1)")->check(CLI::Range(1, 10000));
   c->add_option("--reference-note", o.reference_note, "How the reference was made, for summary.md");
   add_render_options(c, o.render);

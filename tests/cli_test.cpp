@@ -1308,6 +1308,14 @@ TEST_CASE("help lists the samplers and options", "[cli]") {
   CHECK(c.status == 0);
   CHECK(c.output.find("--samplers NAME,NAME,...") != std::string::npos);
   CHECK(c.output.find("TEXT ...") == std::string::npos);
+  // Files, folders and names say so (every one read "TEXT"; a review).
+  for (const char* s : {"SCENE FILE REQUIRED", "--sampler NAME", "-o,--output FILE", "--reference FILE", "--log FILE",
+                        "--checkpoint FILE", "--resume FILE"})
+    CHECK(r.output.find(s) != std::string::npos);
+  CHECK(c.output.find("--out DIR REQUIRED") != std::string::npos);
+  auto d = run_bayeslight("diff --help");
+  CHECK(d.output.find("A FILE REQUIRED") != std::string::npos);
+  CHECK(d.output.find("B FILE REQUIRED") != std::string::npos);
 }
 
 TEST_CASE("an interrupted render writes the completed passes and exits 130 or 143", "[cli]") {
