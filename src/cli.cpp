@@ -690,8 +690,8 @@ int run_cli(int argc, char** argv) {
       "  bayeslight diff out.exr ref.exr\n"
       "Each command's options: bayeslight COMMAND --help. The version and build: bayeslight --version.\n"
       "Exit status: 0 success; 1 other failure (e.g. an output that cannot be written); 2 bad command line; 3 bad "
-      "input (the message names the file and line); 130/143/129 interrupted (SIGINT/SIGTERM/SIGHUP), after writing the "
-      "image of the passes completed.");
+      "input (the message names the file and line); 130/143/129 interrupted (SIGINT/SIGTERM/SIGHUP): an interrupted "
+      "render or compare first writes the image of the passes completed.");
   render_options ro;
   diff_options dopt;
   compare_options copt;
