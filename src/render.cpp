@@ -295,7 +295,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
 
   const int target = params.time_budget > 0 ? INT_MAX : params.spp;
   int done = result.spp;
-  double seconds_per_spp = 0;  // of the last pass, with the learning and the checkpoint after it (0: none yet)
+  double seconds_per_spp = 0;  // of the last pass, with its learning (0: none yet)
   if (!result.log.empty()) {  // (a resumed render: its checkpoint's last pass)
     const size_t n = result.log.size();
     const double t0 = n > 1 ? result.log[n - 2].seconds : 0.0;
@@ -349,12 +349,16 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     };
     bool complete = run_samples(done, done + count, false);
     // A cut pass that ends before the budget (the machine sped up) goes on with more of its samples, from the same
-    // model and sums: still one pass, the --spp render's of its total, that ends at or past the budget, and never
-    // longer than the scheduled one.
+    // model and sums: still one pass, the --spp render's of its total, and still shorter than the scheduled one. So
+    // it is the render's last whatever happens: what bayes learns from a pass in pieces differs in the last bits from
+    // what it learns from one run of it (its accumulators add the samples in another order), and no later pass may
+    // use that. Where even the scheduled size less one spp ends short of the budget (the machine sped up by more than
+    // the quarter fit_pass_to_time adds), the render ends there, a little early.
     raise = 0;
-    while (complete && count < scheduled && result.seconds + seconds_since(t0) < params.time_budget) {
+    while (complete && count < scheduled - 1 && result.seconds + seconds_since(t0) < params.time_budget) {
       const double elapsed = seconds_since(t0);
-      const int more = fit_pass_to_time(scheduled - count, params.time_budget - result.seconds - elapsed, elapsed / count);
+      const int more =
+          fit_pass_to_time(scheduled - 1 - count, params.time_budget - result.seconds - elapsed, elapsed / count);
       progress.spp_done = done + count;  // (the bar's running pass: this piece, from its start)
       progress.pass_spp = more;
       progress.rows_done = 0;
@@ -396,6 +400,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     result.learn_seconds += seconds_since(tl);
     if constexpr (std::is_same_v<Sampler, bayes_sampler>) result.learn_parts = sampler.timing;
     result.seconds += seconds_since(t0);
+    // (Not the checkpoint after it: a cut pass, the last, has none.)
+    seconds_per_spp = (result.seconds - cycle_start) / count;
     done += count;
     result.spp = done;
     result.passes = pass + 1;
@@ -422,7 +428,6 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
       after_pass();
       result.seconds += seconds_since(ta);
     }
-    seconds_per_spp = (result.seconds - cycle_start) / count;
     if (cut) break;
   }
 }
@@ -449,8 +454,9 @@ bool ends_scheduled_pass(int spp, int64_t pixels) {
 
 int fit_pass_to_time(int count, double left, double seconds_per_spp) {
   if (count <= 1 || !(seconds_per_spp > 0) || !(left > 0)) return count;
-  // (A tenth more than the last pass's speed says: a pass that ends short of the budget ends the render there.)
-  const double fits = std::ceil(1.1 * left / seconds_per_spp);
+  // (A quarter more than the last pass's speed says: a pass that ends short of the budget goes on, but only up to
+  // its scheduled size less one spp.)
+  const double fits = std::ceil(1.25 * left / seconds_per_spp);
   return fits < double(count) ? std::max(1, int(fits)) : count;
 }
 

@@ -101,11 +101,11 @@ int pass_size(int pass, int done, int64_t pixels);
 // takes the same passes as one render of more spp.
 bool ends_scheduled_pass(int spp, int64_t pixels);
 // Samples per pixel of the next pass of a --time render with `left` seconds of its budget left: `count` (its
-// scheduled size), or fewer where the last pass's `seconds_per_spp` (its learning and what followed it included)
-// says fewer fill the time left (a tenth more, rounded up, so that the pass ends past the budget unless the machine
-// speeds up; at least 1). Where it cuts, that pass is the render's last; where it then ends before the budget, it goes
-// on with more of its samples (the same model and sums), sized alike from its own speed so far.
-// Without a speed (0: no pass timed yet): `count`.
+// scheduled size), or fewer where the last pass's `seconds_per_spp` (its learning included) says fewer fill the time
+// left (a quarter more, rounded up, so that the pass ends past the budget unless the machine speeds up by more than
+// that; at least 1). Without a speed (0: no pass timed yet): `count`. A cut pass is the render's last; where it ends
+// short of the budget, it goes on with more of its samples (the same model and sums), sized alike from its own speed,
+// up to its scheduled size less one spp.
 int fit_pass_to_time(int count, double left, double seconds_per_spp);
 // Weight of the samples of a pass that starts after `done` spp: (done + 1) / (done + 1 + s), 1 for s = 0.
 double pass_weight(int done, double s);
