@@ -3,6 +3,7 @@
 // its exit statuses, and the pieces it is built from (time to a target error, the plot writer, the ramp).
 #include "compare.h"
 #include "metrics.h"
+#include "render.h"
 #include "error_image.h"
 #include "image_io.h"
 #include "svg_plot.h"
@@ -433,10 +434,19 @@ TEST_CASE("compare at equal time gives every sampler the same budget", "[compare
   check_outputs(out, {"bound", "uniform"}, 1, 0.25);
   for (const csv_row& row : read_curves(out + "/curves.csv")) CHECK(row.seconds > 0);
   std::map<std::string, double> final_seconds, final_relmse;
-  for (const csv_row& row : read_curves(out + "/curves.csv"))
+  std::map<std::string, int> final_spp, before_spp, passes;
+  for (const csv_row& row : read_curves(out + "/curves.csv")) {
     final_seconds[row.sampler] = row.seconds, final_relmse[row.sampler] = row.relmse;
-  CHECK(final_seconds["bound"] >= 0.25);
-  CHECK(final_seconds["uniform"] >= 0.25);
+    before_spp[row.sampler] = final_spp[row.sampler];
+    final_spp[row.sampler] = row.spp, passes[row.sampler] = row.pass;
+  }
+  for (const char* k : {"bound", "uniform"}) {
+    INFO(k);
+    // Each ran to the budget, or ended short of it in a last pass cut to the time left (the machine sped up by more
+    // than the quarter a cut pass adds: render.cpp; it happened under load). A cut pass is shorter than scheduled.
+    const bool cut = final_spp[k] - before_spp[k] < pass_size(passes[k] - 1, before_spp[k], 16 * 12);
+    CHECK((final_seconds[k] >= 0.25 || cut));
+  }
   CHECK(slurp(out + "/summary.md").find("Equal time: 0.25 s") != std::string::npos);
   // The last column is the written image's relMSE: its last pass's (the relMSE column is at exactly 0.25 s).
   auto table = read_summary_table(slurp(out + "/summary.md"));
