@@ -32,6 +32,7 @@ struct render_options {
   region_params regions = [] {
     region_params r;
     r.max_pairs = -1;  // auto (region_params::auto_pairs_per_pixel) unless --region-budget is given
+    r.grid = -1;       // auto (region_params::auto_grid, by the image's pixel count) unless --grid is given
     return r;
   }();
   bayes_params bayes;

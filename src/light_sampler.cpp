@@ -63,6 +63,7 @@ region_params effective_region_params(const sampler_params& params, int max_dept
   // tracing most NEE events are at deep vertices and refined learning costs more time than it saves (README).
   if (rp.max_members < 0) rp.max_members = max_depth == 1 ? region_params::auto_members : 0;
   rp.max_members = members ? std::min(rp.max_members, max_cut_entries - 1) : 0;
+  if (rp.grid < 0) rp.grid = learned ? region_params::auto_grid(pixels) : region_params::default_grid;
   if (rp.max_pairs < 0)
     rp.max_pairs = learned ? std::max<int64_t>(1, std::min(region_params::default_pairs,
                                                            region_params::auto_pairs_per_pixel * pixels))

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
 #include <queue>
 #include <unordered_set>
 
@@ -172,6 +173,12 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
   }
   s.root = 0;
   return s;
+}
+
+// 64 * sqrt(pixels / (320 * 240)), rounded, within [16, 64]: 160x120 gets 32, 80x60 16 (README).
+int region_params::auto_grid(int64_t pixels) {
+  const double g = std::round(double(default_grid) * std::sqrt(double(std::max<int64_t>(pixels, 1)) / (320.0 * 240.0)));
+  return int(std::clamp(g, 16.0, double(default_grid)));
 }
 
 uint64_t fine_region_key(const region_grid_data& g, vec3f p) {

@@ -274,7 +274,7 @@ TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[ch
         other_render{base_args("bayes") + " --bayes-b0 2", "the bayes options (--bayes-*)"},
         other_render{base_args("bayes") + " --light-samples 2",
                      "the light samples (--independent-samples, --light-samples)"},
-        other_render{base_args("bayes") + " --grid 16",
+        other_render{base_args("bayes") + " --grid 32",  // (16 is the automatic grid at 40x30)
                      "the region options (--grid, --max-cut, --cut-*, --region-*, --shared-cut-lights, --fine-depth)"},
         // (the automatic pair budget follows the image size: the region options are not named too)
         other_render{size_args, "the image size (40x30 there)"},
