@@ -59,7 +59,9 @@ void add_render_options(CLI::App* r, render_options& o) {
               "stratified over each pixel's samples, or over each pass's for the adaptive samplers)");
   // Regions, cuts and the ablation switches of the adaptive samplers.
   const char* grp = region_group;
-  r->add_option("--grid", o.regions.grid, "Region cells along the shortest axis of the scene bounds (default 64; bayes in images under 320x240 pixels: 64 * sqrt(pixels / 76800), rounded, at least 16)")
+  r->add_option("--grid", o.regions.grid,
+                "Region cells along the shortest axis of the scene bounds (default 64; bayes in images under 320x240 "
+                "pixels: 64 * sqrt(pixels / 76800), rounded, at least 16)")
       ->check(CLI::Range(1, 100000))->group(grp);
   r->add_option("--max-cut", o.regions.max_cut, "Light clusters per region (default 64, at most 1024)")
       ->check(CLI::Range(1, 1024))->group(grp);

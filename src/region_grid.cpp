@@ -177,7 +177,8 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
 
 // 64 * sqrt(pixels / (320 * 240)), rounded, within [16, 64]: 160x120 gets 32, 80x60 16 (README).
 int region_params::auto_grid(int64_t pixels) {
-  const double g = std::round(double(default_grid) * std::sqrt(double(std::max<int64_t>(pixels, 1)) / (320.0 * 240.0)));
+  const double g =
+      std::round(double(default_grid) * std::sqrt(double(std::max<int64_t>(pixels, 1)) / (320.0 * 240.0)));
   return int(std::clamp(g, 16.0, double(default_grid)));
 }
 
