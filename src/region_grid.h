@@ -19,12 +19,12 @@ namespace bl {
 
 // Options of regions and cuts.
 struct region_params {
-  int grid = 64;                   // fine cells along the shortest axis of the scene bounds; -1: automatic (below)
   // The command line's default grid (grid -1, resolved by effective_region_params): for bayes auto_grid(pixels),
   // 64 (the paper's) from 320x240 up, coarser in smaller images, whose regions would otherwise each get under a
   // pixel's samples per pass and learn too slowly (README); for the other samplers 64.
   static constexpr int default_grid = 64;
   static int auto_grid(int64_t pixels);
+  int grid = default_grid;         // fine cells along the shortest axis of the scene bounds; -1: automatic (above)
   int max_cut = 64;                // clusters per region (the sun, if any, comes on top)
   float cut_threshold = 0.005f;    // stop refining when every cluster bound < threshold * total
   float coherence = 0.25f;         // keep a node whole when radius / gap to the region <= this and its
