@@ -464,6 +464,33 @@ TEST_CASE("the automatic region budget is 32 pairs per pixel for bayes, within t
   }
 }
 
+
+TEST_CASE("bayes's automatic grid scales with the image below 320x240, the others keep 64, and --grid wins",
+          "[samplers][regions]") {
+  // 64 * sqrt(pixels / 76800), rounded, within [16, 64] (README).
+  CHECK(region_params::auto_grid(320 * 240) == 64);
+  CHECK(region_params::auto_grid(640 * 480) == 64);
+  CHECK(region_params::auto_grid(160 * 120) == 32);
+  CHECK(region_params::auto_grid(128 * 96) == 26);
+  CHECK(region_params::auto_grid(80 * 60) == 16);
+  CHECK(region_params::auto_grid(40 * 30) == 16);
+  CHECK(region_params::auto_grid(1) == 16);
+  CHECK(region_params::auto_grid(0) == 16);
+  CHECK(region_params::auto_grid(319 * 240) == 64);  // 63.9 rounds up
+  CHECK(region_params::auto_grid(300 * 225) == 60);
+  sampler_params sp;
+  sp.regions.grid = -1;  // the command line's default
+  sp.kind = sampler_kind::bayes;
+  CHECK(effective_region_params(sp, 1, 160 * 120).grid == 32);
+  CHECK(effective_region_params(sp, 5, 1920 * 1080).grid == 64);
+  for (sampler_kind k : {sampler_kind::bound, sampler_kind::bvh, sampler_kind::donikian}) {
+    sp.kind = k;
+    CHECK(effective_region_params(sp, 1, 160 * 120).grid == region_params::default_grid);
+  }
+  sp.kind = sampler_kind::bayes;
+  sp.regions.grid = 48;  // --grid 48
+  CHECK(effective_region_params(sp, 1, 160 * 120).grid == 48);
+}
 TEST_CASE("bayes statistics columns are not reallocated while passes add regions", "[samplers][bayes]") {
   // Regions for every cell a sample asks for (min_samples 1) and paths of 3 segments (deep vertices ask for coarse
   // cells): the pairs grow far past the set-up's, and no column may move (a move copies it whole: a pause of tenths of
