@@ -588,12 +588,16 @@ int run_diff(const diff_options& o) {
   if (a.width != b.width || a.height != b.height)
     throw input_error(o.b, "size " + std::to_string(b.width) + "x" + std::to_string(b.height) + " differs from " +
                                o.a + " (" + std::to_string(a.width) + "x" + std::to_string(a.height) + ")");
-  // A non-finite pixel has no error: say where it is rather than print nan (exit 3, like a reference's).
+  // Bit-equal pixel data are identical whatever they hold (SPEC 4), NaN and infinities included: no error.
+  if (bit_identical(a, b)) {
+    std::printf("relmse=0 mse=0 maxabs=0\nidentical\n");
+    return exit_ok;
+  }
+  // Otherwise a non-finite pixel has no error: say where it is rather than print nan (exit 3, like a reference's).
   require_finite(a, o.a, "image");
   require_finite(b, o.b, "image");
   error_metrics e = compute_error(a, b);
   std::printf("relmse=%.9g mse=%.9g maxabs=%.9g\n", e.relmse, e.mse, e.maxabs);
-  if (bit_identical(a, b)) std::printf("identical\n");
   return exit_ok;
 }
 

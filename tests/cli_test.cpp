@@ -519,6 +519,11 @@ TEST_CASE("bad input files exit 3 name the file and line and leave no output", "
     CHECK(d2.output.find("relmse") == std::string::npos);
   }
   CHECK(run_bayeslight("diff " + (s.dir / "ok.pfm") + " " + (s.dir / "ok.pfm")).status == 0);
+  // Bit-equal images are identical (SPEC 4) even where they hold a non-finite value: nothing to name, no error.
+  auto same = run_bayeslight("diff " + (s.dir / "inf.pfm") + " " + (s.dir / "inf.pfm"));
+  INFO(same.output);
+  CHECK(same.status == 0);
+  CHECK(same.output.find("relmse=0 mse=0 maxabs=0\nidentical\n") != std::string::npos);
 }
 
 TEST_CASE("a camera given in part takes the framing of a bare OBJ for the rest", "[cli]") {
