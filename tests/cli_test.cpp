@@ -555,6 +555,35 @@ TEST_CASE("a camera given in part takes the framing of a bare OBJ for the rest",
   CHECK(eye.pixels != read_image(s.dir / "bare.pfm").pixels);
 }
 
+TEST_CASE("an eye on a surface's plane sees past that surface", "[cli]") {
+  // The eye on the floor's plane, looking up at the lamp: every camera ray hit the floor at t = 0 from below (black,
+  // a review); the first hit now skips the plane the eye lies on, as a ray leaving a surface does.
+  tiny_scene s;
+  auto render_from = [&](const std::string& name, const std::string& eye) {
+    write_text(s.dir / (name + ".json"), "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": " + eye +
+                                             ", \"target\": [0, 1, 0]}, \"render\": {\"max_depth\": 1}}");
+    auto r = run_bayeslight("render " + (s.dir / (name + ".json")) + " --sampler power --spp 2 --width 16 " +
+                            "--height 12 --quiet -o " + (s.dir / (name + ".pfm")));
+    INFO(name << "\n" << r.output);
+    REQUIRE(r.status == 0);
+    return read_image(s.dir / (name + ".pfm"));
+  };
+  for (const char* eye : {"[0, 0, 0.9]", "[0.3, 0, 0.2]"}) {
+    INFO(eye);
+    image_data on = render_from("on", eye);
+    std::string raised = std::string(eye);
+    raised.replace(raised.find(", 0,"), 4, ", 1e-4,");
+    image_data above = render_from("above", raised);
+    double sum_on = 0, sum_above = 0;
+    float max_on = 0;
+    for (size_t i = 0; i < on.pixels.size(); i++)
+      sum_on += on.pixels[i], sum_above += above.pixels[i], max_on = std::max(max_on, on.pixels[i]);
+    CHECK(max_on == 5.0f);  // the lamp's radiance, seen
+    CHECK(sum_above > 0);
+    CHECK(std::fabs(sum_on - sum_above) <= 0.02 * sum_above);
+  }
+}
+
 TEST_CASE("directions of any finite length point the same way", "[cli]") {
   // SPEC 3: the sun's direction is normalised on load. A direction scaled by 1e20 or 1e-25 (its squared length
   // outside float's range) renders the image of the unit one; the camera's "up" likewise.
