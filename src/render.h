@@ -125,7 +125,8 @@ render_result render(const scene_data& scene, const bvh_data& bvh, const light_d
 // comes while on_frame runs ends the animation after that frame (on_pass is then called once more, last = true).
 void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lights, const render_params& params,
                    const std::function<void(int, const render_result&)>& on_frame);
-// The film's weighted mean image, negative values written as zero (zero when no sample completed).
+// The film's weighted mean image, values below zero kept (bayes's control variates; README), zero when no sample
+// completed.
 image_data film_image(const render_result& r);
 
 // Installs SIGINT/SIGTERM handlers. Until interrupted_before_render is called (setting up: nothing written yet) a
