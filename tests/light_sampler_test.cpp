@@ -464,7 +464,6 @@ TEST_CASE("the automatic region budget is 32 pairs per pixel for bayes, within t
   }
 }
 
-
 TEST_CASE("bayes's automatic grid scales with the image below 320x240, the others keep 64, and --grid wins",
           "[samplers][regions]") {
   // 64 * sqrt(pixels / 76800), rounded, within [16, 64] (README).
@@ -491,6 +490,7 @@ TEST_CASE("bayes's automatic grid scales with the image below 320x240, the other
   sp.regions.grid = 48;  // --grid 48
   CHECK(effective_region_params(sp, 1, 160 * 120).grid == 48);
 }
+
 TEST_CASE("bayes statistics columns are not reallocated while passes add regions", "[samplers][bayes]") {
   // Regions for every cell a sample asks for (min_samples 1) and paths of 3 segments (deep vertices ask for coarse
   // cells): the pairs grow far past the set-up's, and no column may move (a move copies it whole: a pause of tenths of
