@@ -120,16 +120,14 @@ inline hit_info continuation_hit(const render_inputs& in, int tri, vec3f p, vec3
   return intersect(*in.bvh, offset_ray_origin(scene, tri, p, ng, d), d);
 }
 
-// The closest hit of a camera ray from the eye in direction d. An eye on a surface's plane (a hand-written ground at
-// y = 0 and an eye at y = 0) would see every ray leaving it hit that surface at t = 0, an image all black or all
-// its back face (a review): such a hit is skipped as continuation_hit skips the surface a ray leaves.
-inline hit_info camera_hit(const render_inputs& in, vec3f eye, vec3f d) {
-  hit_info h = intersect(*in.bvh, eye, d);
-  if (h.tri == invalid_id) return h;
+// The closest hit of a camera ray in direction d. An eye on a surface's plane (a hand-written ground at y = 0 and an
+// eye at y = 0) would see every ray leaving it hit that surface at t = 0, an image all black or all its back face (a
+// review): such a hit is skipped as continuation_hit skips the surface a ray leaves.
+inline hit_info camera_hit(const render_inputs& in, vec3f d) {
   const scene_data& scene = *in.scene;
-  vec3f n = scene.tri_ng[size_t(h.tri)], v = eye - scene.tri_p0[size_t(h.tri)];
-  if (!(std::fabs(dot(n, v)) <= min_ray_epsilon(scene, h.tri, eye) + 1e-6f * max_abs_component(v))) return h;
-  return continuation_hit(in, h.tri, eye, n, d);
+  hit_info h = intersect(*in.bvh, in.camera.eye, d);
+  if (!scene.eye_on_a_plane || h.tri == invalid_id || !on_plane_of(scene, h.tri, in.camera.eye)) return h;
+  return continuation_hit(in, h.tri, in.camera.eye, scene.tri_ng[size_t(h.tri)], d);
 }
 
 // Radiance of sample `sample` of pixel (x, y). `ctxs` are the light-selection contexts of the current and the
@@ -157,7 +155,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
   vec3f from_ng;
   for (int depth = 1;; depth++) {
     if (depth > 1) t0 = tm.start();
-    hit_info h = depth == 1 ? camera_hit(in, org, dir) : continuation_hit(in, from_tri, org, from_ng, dir);
+    hit_info h = depth == 1 ? camera_hit(in, dir) : continuation_hit(in, from_tri, org, from_ng, dir);
     tm.stop(depth == 1 ? prof_camera : prof_bounce, t0);
     t0 = tm.start();
     if (h.tri == invalid_id) {

@@ -24,7 +24,7 @@ std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_g
       std::vector<uint64_t>& row = rows[size_t(y)];
       for (int x = 0; x < w; x++) {
         vec3f dir = camera_ray_dir(in.camera, float(x) + 0.5f, float(y) + 0.5f);
-        hit_info hit = camera_hit(in, in.camera.eye, dir);  // (the render's own first hits)
+        hit_info hit = camera_hit(in, dir);  // (the render's own first hits)
         if (hit.tri == invalid_id) continue;
         surface_point sp = eval_surface(*in.scene, hit.tri, hit.b1, hit.b2, hit.p, dir);
         uint64_t key = fine_region_key(grid, sp.p);

@@ -80,6 +80,8 @@ scene_data build_scene(mesh_data mesh, const camera_params& camera, const sun_pa
     if (!camera.frame_target) s.camera.eye = camera.frame_eye ? camera.target + (f.eye - f.target) : f.eye;
     if (!camera.frame_eye) s.camera.target = f.target;
   }
+  // (Few scenes: the camera's first hits test their triangle's plane only where some plane holds the eye.)
+  for (int t = 0; t < n && !s.eye_on_a_plane; t++) s.eye_on_a_plane = on_plane_of(s, t, s.camera.eye);
   s.sun = sun;
   s.two_sided_emitters = two_sided;
   return s;

@@ -31,6 +31,7 @@ struct scene_data {
   sun_params sun;
   bool two_sided_emitters = false;
   bool has_alpha = false;                     // some material has a map_d cut-out
+  bool eye_on_a_plane = false;                // the camera's eye lies on some triangle's plane (on_plane_of)
 };
 
 // Builds the scene of a scene description (loads the OBJ; frames the camera when automatic).
@@ -89,5 +90,11 @@ inline vec3f offset_ray_origin(const scene_data& scene, int tri, vec3f p, vec3f 
 // errs by more than half an ulp of 1, and a floor of 0.4 ulps let a tilted tile shadow itself under a low sun). Rays start this far off (shadow rays) or count hits from this height on (continuation
 // rays), so that a lamp or an occluder closer to a surface than ray_epsilon is not stepped over.
 inline float min_ray_epsilon(const scene_data& scene, int tri, vec3f p) { return 0.05f * ray_epsilon(scene, tri, p); }
+// Whether point q lies on the plane of triangle tri, within what rounding can put between them (a camera's first hit
+// skips a triangle whose plane holds the eye: integrator.h, camera_hit).
+inline bool on_plane_of(const scene_data& scene, int tri, vec3f q) {
+  vec3f v = q - scene.tri_p0[size_t(tri)];
+  return std::fabs(dot(scene.tri_ng[size_t(tri)], v)) <= min_ray_epsilon(scene, tri, q) + 1e-6f * max_abs_component(v);
+}
 
 }  // namespace bl
