@@ -325,10 +325,14 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     if (params.time_budget > 0) count = fit_pass_to_time(count, params.time_budget - result.seconds, seconds_per_spp);
     const double cycle_start = result.seconds;
     progress.pass = pass + 1;
-    progress.pass_spp = count;
-    progress.rows_done = 0;
-    progress.pass_start_ns =
-        std::chrono::duration_cast<std::chrono::nanoseconds>(clock_type::now().time_since_epoch()).count();
+    // The bar's running pass (or piece of one): its spp and rows, timed from now.
+    auto bar_runs = [&](int spp) {
+      progress.pass_spp = spp;
+      progress.rows_done = 0;
+      progress.pass_start_ns =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(clock_type::now().time_since_epoch()).count();
+    };
+    bar_runs(count);
     auto t0 = clock_type::now();
     // Stratified sets (integrator.h): a set starts with the render and after every change of the sampler's model,
     // so no sample of a set depends on samples its model learned from; a model that stays keeps its set.
@@ -360,10 +364,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
       const int more =
           fit_pass_to_time(scheduled - 1 - count, params.time_budget - result.seconds - elapsed, elapsed / count);
       progress.spp_done = done + count;  // (the bar's running pass: this piece, from its start)
-      progress.pass_spp = more;
-      progress.rows_done = 0;
-      progress.pass_start_ns =
-          std::chrono::duration_cast<std::chrono::nanoseconds>(clock_type::now().time_since_epoch()).count();
+      bar_runs(more);
       complete = run_samples(done + count, done + count + more, true);
       count += more;
     }
