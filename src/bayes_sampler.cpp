@@ -334,27 +334,31 @@ light_choice bayes_sampler::sample_members(const context& ctx, double u, double 
   if (!(pj > 0)) return {};
   int b = ctx.member_begin[j], e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
   int m = b;
-  double p = pj;
+  double p = pj, lo = ctx.cdf[j];  // the member's cell of u: [lo, lo + p)
   if (e - b > 1) {
     // u's place inside the cluster's cell, rescaled to the members' total weight (a cluster chosen has a positive
     // total: its weight is that sum); members of weight 0 are never chosen.
     const float* w = ctx.member_w;
     double floor = member_floor(ctx.group_w[j]), total = ctx.group_total[j];
-    double x = (u - ctx.cdf[j]) / pj * total, run = 0;
+    double x = (u - ctx.cdf[j]) / pj * total, run = 0, start = 0, wm = 0;
     m = -1;
     for (int k = b; k < e; k++) {
       if (!(w[k] > 0)) continue;
-      run += std::max(double(w[k]), floor);
+      start = run;
+      wm = std::max(double(w[k]), floor);
+      run += wm;
       m = k;
       if (x < run) break;
     }
     if (m < 0) return {};
-    p = pj * (std::max(double(w[m]), floor) / total);
+    p = pj * (wm / total);
+    lo += start / total * pj;
   }
   int node = ctx.members[m];
   if (node == sun_cluster) return {lights->sun, float(p), m, 1.0f, p};
+  // u's place inside the member's cell chooses the light: a stratified u stays stratified down to the light.
   double inner = 1;
-  int leaf = sample_by_intensity(*tree, node, u_inner, inner);
+  int leaf = sample_by_intensity(*tree, node, place_in_cell(u, lo, p, u_inner), inner);
   return {tree->light[size_t(leaf)], float(p * inner), m, float(inner), p};
 }
 

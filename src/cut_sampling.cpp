@@ -64,7 +64,7 @@ light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, con
   int node = ctx.nodes[j];
   if (node == sun_cluster) return {lights.sun, float(pj), j, 1.0f, pj};
   double inner = 1;
-  int leaf = sample_by_intensity(tree, node, u_inner, inner);
+  int leaf = sample_by_intensity(tree, node, place_in_cell(u, ctx.cdf[j], pj, u_inner), inner);
   return {tree.light[size_t(leaf)], float(pj * inner), j, float(inner), pj};
 }
 

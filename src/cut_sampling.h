@@ -10,6 +10,7 @@
 #include "lights.h"
 #include "region_grid.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -92,7 +93,16 @@ bool finish_cdf(cut_context& ctx, const double* weights);
 // Probability of cluster j.
 inline double cluster_pmf(const cut_context& ctx, int j) { return ctx.cdf[j + 1] - ctx.cdf[j]; }
 
-// Picks a cluster with u and a light inside it with u_inner.
+// u's place inside a cell [lo, lo + width) that holds it, as a uniform in [0, 1): a stratified u stays stratified
+// over what the cell's choice samples next. A cell narrower than 2^-20 leaves too few of u's 53 bits for a further
+// descent: it takes `fresh` (an independent uniform) instead. Either way the result is uniform given the cell.
+inline double place_in_cell(double u, double lo, double width, double fresh) {
+  if (!(width >= 0x1p-20)) return fresh;
+  return std::clamp((u - lo) / width, 0.0, 0x1.fffffffffffffp-1);
+}
+
+// Picks a cluster with u and a light inside it by intensity, from u's place inside the cluster's cell (u_inner for a
+// cluster below 2^-20: place_in_cell).
 light_choice sample_cut(const cut_context& ctx, const light_tree_data& tree, const light_data& lights, double u,
                         double u_inner);
 // Index in the sorted node list [begin, end) of the node holding `leaf` (itself or an ancestor), or -1.

@@ -241,7 +241,7 @@ contract_report check_contract(const test_scene& t, const S& s, const std::vecto
     int n_samples = do_chi2 ? chi2_samples : 200;
     std::vector<double> obs(size_t(nl) + 1, 0.0);
     for (int i = 0; i < n_samples; i++) {
-      float u1 = unif(rng), u2 = unif(rng);
+      double u1 = unif53(rng), u2 = unif53(rng);
       light_choice c = s.sample(ctx, u1, u2);
       if (c.light == invalid_id) {
         obs[size_t(nl)] += 1;
@@ -334,6 +334,58 @@ TEST_CASE("every light sampler satisfies the sampling contract", "[samplers]") {
         bool lossy = kind == sampler_kind::bvh;
         std::visit([&](const auto& s) { require_contract(check_contract(*t, s, pts, 8, 100 + variant, lossy)); }, ls);
       }
+    }
+  }
+}
+
+TEST_CASE("evenly spaced selection numbers choose every light in proportion, inside clusters too", "[samplers]") {
+  // Stratified sampling hands a sampler u's spread evenly over [0, 1). A sampler that inverts one u down to the
+  // light (the cluster's cell, then u's place inside it for the member and the descent by intensity) gives each
+  // light an interval of u of its probability's length: M evenly spaced u's choose it M * pmf times, less than one
+  // off. A descent that drew its own number (u_inner, held fixed here) would send every u of a cluster to one light.
+  auto t = make_test_scene(false);
+  std::vector<shade_point> pts = shading_points(*t, 40, 5);
+  const int nl = t->lights.count, count = 4096;
+  for (sampler_kind kind : {sampler_kind::power, sampler_kind::bvh, sampler_kind::bound, sampler_kind::donikian,
+                            sampler_kind::bayes}) {
+    if (!sampler_available(kind)) continue;
+    for (int variant = 0; variant < param_variants; variant++) {
+      if (variant >= 1 && (kind == sampler_kind::power || kind == sampler_kind::bvh)) continue;
+      if (variant == 2 && kind != sampler_kind::bayes) continue;
+      INFO("sampler " << sampler_name(kind) << " variant " << variant);
+      light_sampler ls = make_light_sampler(params_variant(kind, variant), t->in, t->tree);
+      std::visit(
+          [&](auto& s) {
+            using S = std::decay_t<decltype(s)>;
+            if constexpr (S::learns) learn_passes(t->in, s, 3);  // (bayes: members of unequal learned weights)
+            auto ctx = std::make_unique<typename S::context>();
+            std::vector<int> hits(static_cast<size_t>(nl));
+            int several = 0;  // points where some chosen cluster holds more than one light
+            double worst = 0;
+            for (const shade_point& sp : pts) {
+              s.prepare(*ctx, sp);
+              std::fill(hits.begin(), hits.end(), 0);
+              std::vector<int> light_of_cluster;
+              bool shared = false;
+              for (int i = 0; i < count; i++) {
+                light_choice c = s.sample(*ctx, (i + 0.5) / count, 0.5);
+                if (c.light == invalid_id) continue;
+                hits[size_t(c.light)]++;
+                if (c.cluster >= 0) {
+                  if (light_of_cluster.size() <= size_t(c.cluster)) light_of_cluster.resize(size_t(c.cluster) + 1, -1);
+                  int& l = light_of_cluster[size_t(c.cluster)];
+                  shared = shared || (l >= 0 && l != c.light);
+                  l = c.light;
+                }
+              }
+              several += shared;
+              for (int l = 0; l < nl; l++)
+                worst = std::max(worst, std::fabs(hits[size_t(l)] - count * double(s.pmf(*ctx, l))));
+            }
+            CHECK(worst < 1.01);
+            if (kind != sampler_kind::power && kind != sampler_kind::bvh) CHECK(several > 0);
+          },
+          ls);
     }
   }
 }

@@ -61,6 +61,12 @@ inline std::unique_ptr<test_scene> build_test_scene(mesh_data mesh, const camera
 // Float random numbers for scattering test geometry: uniform in [0, 1), log-uniform in [lo, hi), a uniform
 // direction, a uniform point in a box.
 inline float unif(pcg32& r) { return uint_to_unit(r()); }
+// A 53-bit uniform from two draws, as the integrator gives a light sampler (vertex_randoms::u53): a cluster's choice
+// leaves its rescaled u to the descent inside it, which needs more bits than a float has.
+inline double unif53(pcg32& r) {
+  uint64_t hi = r(), lo = r();
+  return double(((hi << 21) ^ (lo >> 11)) & ((uint64_t(1) << 53) - 1)) * 0x1p-53;
+}
 inline float log_uniform(pcg32& r, float lo, float hi) { return lo * std::pow(hi / lo, unif(r)); }
 inline vec3f random_unit(pcg32& r) {
   float z = 1 - 2 * unif(r), phi = 2 * pi_f * unif(r);
