@@ -272,7 +272,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
 
     // BSDF continuation.
     t0 = tm.start();
-    bsdf_sample bs = sample_bsdf(bsdf, wo, r.u[dim_bsdf_lobe], r.u[dim_bsdf_u], r.u[dim_bsdf_v]);
+    bsdf_sample bs = sample_bsdf(bsdf, wo, r.u[dim_bsdf_u], r.u[dim_bsdf_v]);
     vec3f fc = bs.pdf > 0 ? eval_bsdf_cos(bsdf, wo, bs.wi) : vec3f{0, 0, 0};
     bool go_on = bs.pdf > 0 && !is_black(fc);
     if (go_on) {

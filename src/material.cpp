@@ -5,6 +5,8 @@
 #include "sampling.h"
 #include "texture.h"
 
+#include <algorithm>
+
 namespace bl {
 
 bsdf_data make_bsdf(const scene_data& scene, const surface_point& sp) {
@@ -50,9 +52,12 @@ float bsdf_pdf(const bsdf_data& b, vec3f wo, vec3f wi) {
   return pdf;
 }
 
-bsdf_sample sample_bsdf(const bsdf_data& b, vec3f wo, float lobe, float u, float v) {
+bsdf_sample sample_bsdf(const bsdf_data& b, vec3f wo, float u, float v) {
   bsdf_sample s;
-  if (lobe < b.spec_prob) {
+  const bool glossy = u < b.spec_prob;
+  if (b.spec_prob > 0 && b.spec_prob < 1)
+    u = std::min(glossy ? u / b.spec_prob : (u - b.spec_prob) / (1 - b.spec_prob), 0x1.fffffep-1f);
+  if (glossy) {
     vec3f r = reflect(wo, b.frame.n);
     s.wi = to_world(make_frame(r), sample_phong_lobe(u, v, b.ns));
   } else {

@@ -57,7 +57,9 @@ struct bsdf_sample {
   vec3f wi;
   float pdf = 0;
 };
-// Samples wi from the lobe mixture with uniforms (lobe, u, v).
-bsdf_sample sample_bsdf(const bsdf_data& b, vec3f wo, float lobe, float u, float v);
+// Samples wi from the lobe mixture with uniforms (u, v): the glossy lobe where u < spec_prob, else the diffuse one,
+// u's place inside its lobe's share (rescaled to [0, 1)) then with v choosing the direction, so (u, v) stratified
+// over a pixel's samples (the first vertex's) stay stratified inside each lobe.
+bsdf_sample sample_bsdf(const bsdf_data& b, vec3f wo, float u, float v);
 
 }  // namespace bl

@@ -21,7 +21,8 @@ enum rng_dim : int {
   dim_light_inner = 1,   // second-level choice inside a cluster (tree descent)
   dim_light_u = 2,       // point on the chosen light
   dim_light_v = 3,       //
-  dim_bsdf_lobe = 4,     // diffuse or glossy lobe
+  dim_bsdf_lobe = 4,     // drawn, not read: the lobe is chosen by dim_bsdf_u (sample_bsdf); kept so that the others
+                         // draw what they drew
   dim_bsdf_u = 5,        // direction inside the lobe
   dim_bsdf_v = 6,        //
   dim_roulette = 7,      // Russian roulette
