@@ -66,7 +66,8 @@ struct bayes_sampler {
   void prepare_region_prior(context& ctx, const shade_point& sp, bool cv_allowed = true) const;
   // A cluster by the point's cdf, then (a cluster of several members) a member by its weight, the cluster's share
   // of u rescaled to [0, 1) choosing it (so a stratified u stays stratified inside the cluster), then a light of the
-  // member by intensity. light_choice::cluster is the member (the pair within the region).
+  // member by intensity, from u's place inside the member's cell (place_in_cell). light_choice::cluster is the member
+  // (the pair within the region).
   light_choice sample(const context& ctx, double u, double u_inner) const {
     if (fallback) return power.sample({}, u, u_inner);
     if (ctx.pair_count == ctx.count) return sample_cut(ctx, *tree, *lights, u, u_inner);

@@ -18,7 +18,8 @@ namespace bl {
 // pixel_jitter's, below).
 enum rng_dim : int {
   dim_light_select = 0,  // path vertices: which light / cluster
-  dim_light_inner = 1,   // second-level choice inside a cluster (tree descent)
+  dim_light_inner = 1,   // the descent inside a cluster whose cell is under 2^-20 of the light choice (place_in_cell);
+                         // larger ones descend with the light choice's own number
   dim_light_u = 2,       // point on the chosen light
   dim_light_v = 3,       //
   dim_bsdf_lobe = 4,     // drawn, not read: the lobe is chosen by dim_bsdf_u (sample_bsdf); kept so that the others

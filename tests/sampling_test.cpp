@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <vector>
 #include <limits>
+#include <vector>
 
 using namespace bl;
 using namespace bl::test;

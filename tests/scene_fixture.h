@@ -64,8 +64,10 @@ inline float unif(pcg32& r) { return uint_to_unit(r()); }
 // A 53-bit uniform from two draws, as the integrator gives a light sampler (vertex_randoms::u53): a cluster's choice
 // leaves its rescaled u to the descent inside it, which needs more bits than a float has.
 inline double unif53(pcg32& r) {
-  uint64_t hi = r(), lo = r();
-  return double(((hi << 21) ^ (lo >> 11)) & ((uint64_t(1) << 53) - 1)) * 0x1p-53;
+  vertex_randoms v;
+  v.raw[dim_light_select] = r();
+  v.raw[dim_light_select_lo] = r();
+  return v.u53(dim_light_select, dim_light_select_lo);
 }
 inline float log_uniform(pcg32& r, float lo, float hi) { return lo * std::pow(hi / lo, unif(r)); }
 inline vec3f random_unit(pcg32& r) {
