@@ -36,9 +36,10 @@ struct render_inputs {
   int max_depth = 5;
   uint64_t seed = 0;
   // The first vertex's light and BSDF dimensions are stratified over sets of a pixel's samples (rng.h,
-  // stratify_first_vertex): samples from stratum_base on form one set, keyed by stratum_key (stratum_key_of). A
-  // sampler without learning has one set for the whole render; a learning one a set per pass, so that the samples
-  // of a pass depend on no earlier sample that its model learned from (which keeps the estimator unbiased).
+  // stratify_sample): for the light choice and point, samples from stratum_base on form one set, keyed by
+  // stratum_key (stratum_key_of). A sampler without learning has one light set for the whole render; a learning one
+  // a set per pass, so that the light samples of a pass depend on no earlier sample that its model learned from
+  // (which keeps the estimator unbiased). The BSDF direction has one set for the whole render with every sampler.
   bool stratify = true;
   uint64_t stratum_base = 0, stratum_key = 0;
   // NEE samples per vertex (light choice, point and shadow ray each; the point's pmf built once): their mean is the
@@ -192,7 +193,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     vertex_randoms r = draw_vertex(key, uint32_t(depth));
     bool last = depth >= in.max_depth;
     if (depth == 1 && in.stratify)
-      stratify_with(ps.strata, uint32_t(sample - in.stratum_base), last, r);
+      stratify_sample(ps, sample, in.stratum_base, last, r);
     typename Sampler::context& ctx = ctxs[depth & 1];
     shade_point spt = make_shade_point(sp.p, bsdf, wo, pixel, depth, last);
     tm.stop(prof_shading, t0);

@@ -334,8 +334,9 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     };
     bar_runs(count);
     auto t0 = clock_type::now();
-    // Stratified sets (integrator.h): a set starts with the render and after every change of the sampler's model,
-    // so no sample of a set depends on samples its model learned from; a model that stays keeps its set.
+    // Stratified light sets (integrator.h): a set starts with the render and after every change of the sampler's
+    // model, so no light sample of a set depends on samples its model learned from; a model that stays keeps its set.
+    // (The BSDF direction's set is the render's, whatever the model.)
     render_inputs pin = in;
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);

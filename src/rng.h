@@ -174,12 +174,14 @@ inline void sobol_pair(uint32_t sample, uint64_t h, uint32_t& a, uint32_t& b) {
 inline uint64_t stratum_key_of(uint64_t seed, uint64_t base) {
   return mix64(mix64(seed ^ 0xbb67ae8584caa73bull) ^ (base * 0x9e3779b97f4a7c15ull));
 }
-// Stratifies over a set of a pixel's samples (`index`: the sample's place in the set, `key`: the set's) the first
-// vertex's light choice (1D), point on the light (2D) and, unless `last`, BSDF direction (2D), replacing those
-// dimensions of r. Each of the three has its own shuffle and shifts, from the pixel's hash; each sample stays
-// uniform, so any estimator stays unbiased, and 2^k consecutive samples from a multiple of 2^k are stratified.
-// The inner choice inside a cluster, the lobe and roulette keep their independent draws.
-// The three sets' hashes are per (set, pixel): stratum_hashes computes them, stratify_with applies them.
+// Stratifies over sets of a pixel's samples the first vertex's light choice (1D), point on the light (2D) and, unless
+// `last`, BSDF direction (2D), replacing those dimensions of r. Each of the three has its own shuffle and shifts,
+// from the hash of its set and pixel (stratum_hashes_of); each sample stays uniform, so any estimator stays
+// unbiased, and 2^k consecutive samples of a set from a multiple of 2^k are stratified. The light dimensions take
+// `index`, the sample's place in its set; the BSDF direction `bsdf_index`, its place in the BSDF's set (in a render:
+// light sets that restart whenever the sampler's model changes, one BSDF set for the whole render; stratify_sample).
+// The draws for a light inside a cell too narrow for the choice's number (dim_light_inner), the unread lobe
+// number and roulette stay independent.
 struct stratum_hashes {
   uint64_t select = 0, point = 0, bsdf = 0;
 };
@@ -195,30 +197,44 @@ inline void stratify_light_with(const stratum_hashes& hs, uint32_t index, vertex
   r.u[dim_light_u] = uint_to_unit(r.raw[dim_light_u]);
   r.u[dim_light_v] = uint_to_unit(r.raw[dim_light_v]);
 }
-inline void stratify_with(const stratum_hashes& hs, uint32_t index, bool last, vertex_randoms& r) {
+
+inline void stratify_with(const stratum_hashes& hs, uint32_t index, uint32_t bsdf_index, bool last, vertex_randoms& r) {
   stratify_light_with(hs, index, r);
   if (last) return;
-  sobol_pair(index, hs.bsdf, r.raw[dim_bsdf_u], r.raw[dim_bsdf_v]);
+  sobol_pair(bsdf_index, hs.bsdf, r.raw[dim_bsdf_u], r.raw[dim_bsdf_v]);
   r.u[dim_bsdf_u] = uint_to_unit(r.raw[dim_bsdf_u]);
   r.u[dim_bsdf_v] = uint_to_unit(r.raw[dim_bsdf_v]);
 }
+// All three dimensions from one set (key `key`, place `index`).
 inline void stratify_first_vertex(uint64_t key, uint64_t pixel, uint32_t index, bool last, vertex_randoms& r) {
-  stratify_with(stratum_hashes_of(key, pixel), index, last, r);
+  stratify_with(stratum_hashes_of(key, pixel), index, index, last, r);
 }
 
 // What a pixel's samples share, computed once per pixel and pass (the per-pixel parts of sample_key, pixel_jitter
-// and stratify_first_vertex), so that a sample draws exactly what those functions give.
+// and the stratified sets), so that a sample draws exactly what those functions give.
 struct pixel_streams {
   uint64_t key_base = 0;          // pixel_key_base
   uint32_t shift_x = 0, shift_y = 0;  // jitter_shift
-  stratum_hashes strata;          // stratum_hashes_of the pass's set
+  // select, point: stratum_hashes_of the pass's light set (key stratum_key); bsdf: of the render's first set (key
+  // stratum_key_of(seed, 0)), which the BSDF direction keeps for the whole render.
+  stratum_hashes strata;
 };
 inline pixel_streams pixel_streams_of(uint64_t seed, uint64_t stratum_key, uint64_t pixel) {
   pixel_streams ps;
   ps.key_base = pixel_key_base(seed, pixel);
   jitter_shift(seed, pixel, ps.shift_x, ps.shift_y);
   ps.strata = stratum_hashes_of(stratum_key, pixel);
+  ps.strata.bsdf = stratum_hashes_of(stratum_key_of(seed, 0), pixel).bsdf;
   return ps;
+}
+// The first vertex's stratified dimensions of sample `sample` of a render whose light set began at sample `base`
+// (ps: pixel_streams_of that set's key). The light choice and point take the sample's place in the light set, which
+// restarts whenever the sampler's model changes, so that no light sample depends on samples its model learned from.
+// The BSDF direction takes the sample number in the render's one BSDF set, as the camera jitter does: its sampling
+// does not depend on the model (what a model learned from a pixel's earlier samples reaches a later one only through
+// the MIS weights of a light its BSDF direction hits, one observation among its region's many).
+inline void stratify_sample(const pixel_streams& ps, uint64_t sample, uint64_t base, bool last, vertex_randoms& r) {
+  stratify_with(ps.strata, uint32_t(sample - base), uint32_t(sample), last, r);
 }
 
 }  // namespace bl

@@ -202,6 +202,48 @@ TEST_CASE("the first vertex's light and BSDF samples are stratified over a set, 
   CHECK(first_vertex(stratum_key_of(6, 0), 7, 3).raw[dim_light_u] != first_vertex(key, 7, 3).raw[dim_light_u]);
 }
 
+TEST_CASE("a render's first-vertex BSDF directions form one set while its light sets restart with the model", "[rng]") {
+  // A learning render's light sets restart at every change of its model (here at samples 8, 10, 12, 16, 32 and 48);
+  // its BSDF directions stay one set, as a fixed sampler's: over samples 0-63 of a pixel, one in each cell of every
+  // 2^a x 2^(6-a) grid.
+  const uint64_t seed = 5;
+  const uint64_t bases[] = {0, 8, 10, 12, 16, 32, 48};
+  auto base_of = [&](uint64_t s) {
+    uint64_t b = 0;
+    for (uint64_t x : bases)
+      if (x <= s) b = x;
+    return b;
+  };
+  for (uint64_t px = 0; px < 40; px++) {
+    std::set<int> bsdf[7];
+    std::set<int> select;
+    for (uint64_t s = 0; s < 64; s++) {
+      const uint64_t base = base_of(s);
+      vertex_randoms r = draw_vertex(sample_key(seed, px, s), 1);
+      stratify_sample(pixel_streams_of(seed, stratum_key_of(seed, base), px), s, base, false, r);
+      for (int a = 0; a <= 6; a++)
+        bsdf[a].insert(int(r.u[dim_bsdf_u] * float(1 << a)) * 64 + int(r.u[dim_bsdf_v] * float(1 << (6 - a))));
+      // The same direction as in a render whose set never restarts.
+      vertex_randoms fixed = draw_vertex(sample_key(seed, px, s), 1);
+      stratify_sample(pixel_streams_of(seed, stratum_key_of(seed, 0), px), s, 0, false, fixed);
+      CHECK(r.raw[dim_bsdf_u] == fixed.raw[dim_bsdf_u]);
+      CHECK(r.raw[dim_bsdf_v] == fixed.raw[dim_bsdf_v]);
+      // The light dimensions are those of the sample's place in its own set.
+      vertex_randoms own = draw_vertex(sample_key(seed, px, s), 1);
+      stratify_first_vertex(stratum_key_of(seed, base), px, uint32_t(s - base), false, own);
+      CHECK(r.raw[dim_light_select] == own.raw[dim_light_select]);
+      CHECK(r.raw[dim_light_u] == own.raw[dim_light_u]);
+      CHECK(r.raw[dim_light_v] == own.raw[dim_light_v]);
+      if (base == 32) select.insert(int(r.u53(dim_light_select, dim_light_select_lo) * 16));
+    }
+    for (int a = 0; a <= 6; a++) {
+      INFO("pixel " << px << ", grid 2^" << a << " x 2^" << 6 - a);
+      CHECK(bsdf[a].size() == 64);
+    }
+    CHECK(select.size() == 16);  // (the set of samples 32-47: one light choice in each 1/16)
+  }
+}
+
 TEST_CASE("make_frame is orthonormal for any unit normal", "[math]") {
   for (int i = 0; i < 1000; i++) {
     auto r = draw_vertex(sample_key(1, i, 0), 0);
