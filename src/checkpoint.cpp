@@ -23,9 +23,9 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 6: bayes fallback check; 7: no point-prior weights in region-prior mode; 8: the stratified set's first sample;
 // 9: members; 10: reversed twin faces (a ray meets the one turned toward it); 11: hashed per-vertex PCG32 seeds; 12: the
 // reference's hash; 13: the region options as resolved in the fingerprint, Kd 0 for a library material without one;
-// 14: hits on huge triangles take the ray's point, a thin scene's cells its own shortest extent; 15: map_d's -imfchan
-// and an RGB mask's luminance, cells of at least 4 ulps
-constexpr uint32_t version = 16;  // 16: the fingerprint's parts
+// 14: hits on huge triangles take the ray's point, a thin scene's cells its own shortest extent; 15: map_d's
+// -imfchan and an RGB mask's luminance, cells of at least 4 ulps; 16: the fingerprint's parts
+constexpr uint32_t version = 17;  // 17: the first vertex's BSDF direction in the render's stratified set
 
 }  // namespace
 
@@ -649,8 +649,8 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   }
   result.film = r.column<double>(size_t(w) * size_t(hgt) * 3);
   result.film_weight = r.value<double>();
-  // One log record per pass, numbered from 1, each adding samples; the set of stratified samples starts at a pass's
-  // end (or at 0).
+  // One log record per pass, numbered from 1, each adding samples; the stratified light set starts at a pass's end
+  // (or at 0).
   bool passes_ok = result.passes >= 0 && uint64_t(result.passes) == result.log.size() &&
                    std::isfinite(result.seconds) && result.seconds >= 0;
   bool base_ok = result.stratum_base == 0;
