@@ -56,7 +56,8 @@ void add_render_options(CLI::App* r, render_options& o) {
       ->check(CLI::Range(0.0, 1e9))->check(finite_number);
   r->add_flag("--independent-samples", o.independent,
               "Independent random light choices, light points and BSDF directions at the first hit (default: "
-              "stratified over each pixel's samples, or over each pass's for the adaptive samplers)");
+              "stratified over each pixel's samples; the light choice and point of the adaptive samplers over the "
+              "samples since their model last changed)");
   // Regions, cuts and the ablation switches of the adaptive samplers.
   const char* grp = region_group;
   r->add_option("--grid", o.regions.grid,

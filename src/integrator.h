@@ -38,8 +38,9 @@ struct render_inputs {
   // The first vertex's light and BSDF dimensions are stratified over sets of a pixel's samples (rng.h,
   // stratify_sample): for the light choice and point, samples from stratum_base on form one set, keyed by
   // stratum_key (stratum_key_of). A sampler without learning has one light set for the whole render; a learning one
-  // a set per pass, so that the light samples of a pass depend on no earlier sample that its model learned from
-  // (which keeps the estimator unbiased). The BSDF direction has one set for the whole render with every sampler.
+  // a new set at every change of its model (every pass while it learns), so that no light sample depends on an
+  // earlier sample its model learned from. The BSDF direction has one set for the whole render with every sampler
+  // (rng.h, stratify_sample, says what that costs bayes's unbiasedness).
   bool stratify = true;
   uint64_t stratum_base = 0, stratum_key = 0;
   // NEE samples per vertex (light choice, point and shadow ray each; the point's pmf built once): their mean is the

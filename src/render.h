@@ -77,7 +77,7 @@ struct render_result {
   double film_weight = 0;     // the sum of the weights of one pixel's samples (= spp when all weigh 1)
   int spp = 0;                // samples per pixel in the film
   int passes = 0;
-  int stratum_base = 0;       // first sample of the current stratified set (integrator.h): the last change of model
+  int stratum_base = 0;       // first sample of the stratified light set (integrator.h): the last change of model
   bool interrupted = false;
   double seconds = 0;         // render wall time (passes and learning, not error computation)
   double setup_seconds = 0;   // light tree, regions (before the first pass; not in `seconds`)

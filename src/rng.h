@@ -5,7 +5,8 @@
 // So changing the light sampler (which uses only the light dimensions) leaves camera rays and BSDF samples
 // untouched, and no random number depends on thread identity or timing. The camera's jitter and, at the first
 // vertex, the light choice, light point and BSDF direction come instead from randomised Sobol' sets over a pixel's
-// samples (pixel_jitter, stratify_first_vertex): still functions of (seed, pixel, sample) alone.
+// samples (pixel_jitter, stratify_sample): still functions of (seed, pixel, sample) and where the render's stratified
+// light set began.
 #pragma once
 
 #include <pcg_random.hpp>
@@ -231,8 +232,10 @@ inline pixel_streams pixel_streams_of(uint64_t seed, uint64_t stratum_key, uint6
 // (ps: pixel_streams_of that set's key). The light choice and point take the sample's place in the light set, which
 // restarts whenever the sampler's model changes, so that no light sample depends on samples its model learned from.
 // The BSDF direction takes the sample number in the render's one BSDF set, as the camera jitter does: its sampling
-// does not depend on the model (what a model learned from a pixel's earlier samples reaches a later one only through
-// the MIS weights of a light its BSDF direction hits, one observation among its region's many).
+// does not depend on the model. The model it meets may have learned from the same pixel's earlier paths (their deeper
+// vertices went where the set's earlier directions sent them), which reaches the estimate only through the MIS weight
+// of a light the direction hits: consistent, with a bias that shrinks with the pixel's share of what its region learned
+// (none measurable: README, Samplers).
 inline void stratify_sample(const pixel_streams& ps, uint64_t sample, uint64_t base, bool last, vertex_randoms& r) {
   stratify_with(ps.strata, uint32_t(sample - base), uint32_t(sample), last, r);
 }
