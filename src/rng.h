@@ -198,7 +198,6 @@ inline void stratify_light_with(const stratum_hashes& hs, uint32_t index, vertex
   r.u[dim_light_u] = uint_to_unit(r.raw[dim_light_u]);
   r.u[dim_light_v] = uint_to_unit(r.raw[dim_light_v]);
 }
-
 inline void stratify_with(const stratum_hashes& hs, uint32_t index, uint32_t bsdf_index, bool last, vertex_randoms& r) {
   stratify_light_with(hs, index, r);
   if (last) return;
