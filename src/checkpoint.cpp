@@ -2,6 +2,7 @@
 // Layout: magic, version, fingerprint, sampler kind, pass state, log, film, sampler state, checksum; all integers
 // and floats little-endian as in memory (x86-64 only, like the rest of the renderer's determinism promise).
 #include "checkpoint.h"
+#include "light_points.h"
 
 #include "errors.h"
 #include "file_io.h"
@@ -25,7 +26,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // reference's hash; 13: the region options as resolved in the fingerprint, Kd 0 for a library material without one;
 // 14: hits on huge triangles take the ray's point, a thin scene's cells its own shortest extent; 15: map_d's
 // -imfchan and an RGB mask's luminance, cells of at least 4 ulps; 16: the fingerprint's parts
-constexpr uint32_t version = 17;  // 17: the first vertex's BSDF direction in the render's stratified set
+// 17: the first vertex's BSDF direction in the render's stratified set
+constexpr uint32_t version = 18;  // 18: the tiles' statistics of --light-points auto
 
 }  // namespace
 
@@ -351,7 +353,7 @@ const char* fingerprint_part_name(int part) {
     case fp_max_depth: return "--max-depth";
     case fp_seed: return "the seed";
     case fp_sampler: return "the sampler";
-    case fp_light_samples: return "the light samples (--independent-samples, --light-samples)";
+    case fp_light_samples: return "the light samples (--independent-samples, --light-samples, --light-points)";
     case fp_animation: return "the animation (--frames, the sun's direction_end, --spp or --time)";
     case fp_learning_weights: return "--pass-weighting or --frame-decay";
     case fp_regions:
@@ -400,6 +402,7 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
   h.begin(fp_light_samples);
   h.value(p.stratify);
   if (p.light_samples != 1) h.value(p.light_samples);  // (one: the fingerprint of checkpoints from before the option)
+  if (p.light_points != 1) h.value(uint64_t(0x6c69676874707473)), h.value(p.light_points);  // (0: auto)
   const sampler_kind k = p.sampler.kind;
   h.begin(fp_animation);
   if (p.frames > 1) {
@@ -550,6 +553,7 @@ static void emit_checkpoint(writer& w, const render_fingerprint_data& fingerprin
   }
   w.column(result.film);
   w.value(result.film_weight);
+  w.column(result.point_stats);
   write_sampler(w, sampler);
 }
 
@@ -649,6 +653,14 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   }
   result.film = r.column<double>(size_t(w) * size_t(hgt) * 3);
   result.film_weight = r.value<double>();
+  // --light-points auto: the tiles' sums (empty before its first pass), every one finite and not negative.
+  result.point_stats = r.column<double>();
+  const size_t point_stats_size =
+      size_t(point_tile_cols(w)) * size_t(point_tile_rows(hgt)) * size_t(point_stat_fields);
+  if (!(result.point_stats.empty() || (params.light_points == 0 && result.point_stats.size() == point_stats_size)))
+    r.fail("light point statistics");
+  for (double x : result.point_stats)
+    if (!(std::isfinite(x) && x >= 0)) r.fail("light point statistics");
   // One log record per pass, numbered from 1, each adding samples; the stratified light set starts at a pass's end
   // (or at 0).
   bool passes_ok = result.passes >= 0 && uint64_t(result.passes) == result.log.size() &&

@@ -135,6 +135,7 @@ render_params resolve_params(const render_options& o, const scene_desc& desc, sa
   p.pass_weighting = o.pass_weighting;
   p.stratify = !o.independent;
   p.light_samples = o.light_samples;
+  p.light_points = o.light_points;
   p.progress = p.notes = !o.quiet && stderr_is_terminal();
   return p;
 }

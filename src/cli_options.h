@@ -43,6 +43,7 @@ struct render_options {
   double pass_weighting = 4;
   bool independent = false;
   int light_samples = 1;
+  int light_points = 1;  // --light-points (0: auto)
   std::string checkpoint;
   double checkpoint_every = 30;
   std::string resume;

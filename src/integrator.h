@@ -9,6 +9,7 @@
 #include "bvh.h"
 #include "camera.h"
 #include "light_sampler_types.h"
+#include "light_points.h"
 #include "lights.h"
 #include "material.h"
 #include "profile_timers.h"
@@ -46,11 +47,27 @@ struct render_inputs {
   // NEE samples per vertex (light choice, point and shadow ray each; the point's pmf built once): their mean is the
   // vertex's NEE estimate, MIS-weighted as nee_samples draws against one BSDF draw.
   int nee_samples = 1;
+  // Light points per NEE draw at the first vertex (light_points.h): K points on the chosen light, each with its
+  // shadow ray, averaged. One count for the whole image (light_points), or with point_tiles (--light-points auto)
+  // the count of the pixel's tile of point_tile_size^2 pixels, point_tile_cols tiles to a row.
+  int light_points = 1;
+  const uint8_t* point_tiles = nullptr;
+  int point_tile_cols = 0;
+};
+
+// What one sample reports beside its radiance (the choice of light points, light_points.h).
+struct sample_info {
+  // Sum over the first vertex's NEE draws of the sample variance of their points' contributions (each taken as if it
+  // were the draw's only point): an unbiased estimate of what the variance inside the chosen lights adds to a sample
+  // of one point per draw. 0 with one point.
+  double within = 0;
+  int points = 1;  // light points per draw at the first vertex
 };
 
 // Counters of one worker's share of a pass (summed in a fixed order afterwards).
 struct path_stats {
   uint64_t camera_rays = 0, shadow_rays = 0, bounce_rays = 0, nee_samples = 0, nee_zero = 0, bad_samples = 0;
+  uint64_t first_draws = 0, first_points = 0;  // the first vertex's NEE draws, and the light points they drew
 };
 inline void add_stats(path_stats& a, const path_stats& b) {
   a.camera_rays += b.camera_rays;
@@ -59,6 +76,8 @@ inline void add_stats(path_stats& a, const path_stats& b) {
   a.nee_samples += b.nee_samples;
   a.nee_zero += b.nee_zero;
   a.bad_samples += b.bad_samples;
+  a.first_draws += b.first_draws;
+  a.first_points += b.first_points;
 }
 
 // A sink that drops NEE events (non-learning samplers).
@@ -138,7 +157,8 @@ inline hit_info camera_hit(const render_inputs& in, vec3f d) {
 // (profile_timers.h; no_timers compiles every timer away).
 template <class Sampler, class Sink, class Timers>
 vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, int y, const pixel_streams& ps,
-                       uint64_t sample, path_stats& st, Sink& sink, typename Sampler::context (&ctxs)[2], Timers& tm) {
+                       uint64_t sample, path_stats& st, Sink& sink, typename Sampler::context (&ctxs)[2], Timers& tm,
+                       sample_info* info = nullptr) {
   const scene_data& scene = *in.scene;
   const light_data& lights = *in.lights;
   int pixel = y * in.camera.width + x;
@@ -153,6 +173,11 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
   vec3f radiance = {0, 0, 0}, beta = {1, 1, 1};
   bool prev_mis = false;           // the current ray was BSDF-sampled at a vertex that also ran weighted NEE
   float prev_bsdf_pdf = 0;
+  float prev_nee_points = 1;       // ... whose NEE drew this many light points (draws times points per draw)
+  const int points1 = in.point_tiles ? int(in.point_tiles[size_t(y / point_tile_size) * size_t(in.point_tile_cols) +
+                                                          size_t(x / point_tile_size)])
+                                     : in.light_points;
+  if (info) *info = sample_info{0, points1};
   int from_tri = invalid_id;       // a continuation ray: the triangle it leaves, and its normal (org is its point)
   vec3f from_ng;
   for (int depth = 1;; depth++) {
@@ -164,7 +189,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       if (in_sun_disk(lights, dir)) {
         float w = 1;
         if (prev_mis)
-          w = power_heuristic(prev_bsdf_pdf, float(in.nee_samples) * sampler.pmf(ctxs[(depth - 1) & 1], lights.sun) *
+          w = power_heuristic(prev_bsdf_pdf, prev_nee_points * sampler.pmf(ctxs[(depth - 1) & 1], lights.sun) *
                                                  cone_pdf(lights.sun_one_minus_cos));
         radiance += beta * lights.sun_radiance * w;
       }
@@ -179,7 +204,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
         float w = 1;
         if (prev_mis) {
           float cos_l = std::fabs(dot(scene.tri_ng[h.tri], dir));
-          float light_pdf = float(in.nee_samples) * sampler.pmf(ctxs[(depth - 1) & 1], hit_light) *
+          float light_pdf = prev_nee_points * sampler.pmf(ctxs[(depth - 1) & 1], hit_light) *
                             triangle_light_pdf(scene, lights, hit_light, org, h.t, cos_l);
           w = power_heuristic(prev_bsdf_pdf, light_pdf);
         }
@@ -208,9 +233,12 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     sampler.prepare(ctx, spt);
     tm.stop(prof_pmf, t0);
 
-    // Next-event estimation: nee_samples draws, each its own light choice, point and shadow ray.
+    // Next-event estimation: nee_samples draws, each its own light choice and shadow ray, and at the first vertex
+    // `points` points on the chosen light (a shifted lattice, light_point_uv), each with its shadow ray.
     const int n_nee = in.nee_samples;
-    const float inv_n = 1.0f / float(n_nee);
+    const int points = depth == 1 ? points1 : 1;
+    const float inv_n = 1.0f / float(n_nee), inv_points = 1.0f / float(points);
+    const float nee_points = float(n_nee) * float(points);
     for (int k = 0; k < n_nee; k++) {
       vertex_randoms rk_own;
       const vertex_randoms* rk = &r;
@@ -226,26 +254,44 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       tm.stop(prof_select, t0);
       if (!(choice.light != invalid_id && choice.prob > 0)) continue;
       st.nee_samples++;
+      if (depth == 1) st.first_draws++, st.first_points += uint64_t(points);
       float value = 0, added = 0, added_total = 0;
-      t0 = tm.start();
-      light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, rk->u[dim_light_u], rk->u[dim_light_v]);
-      vec3f fc = ls.pdf > 0 ? eval_bsdf_cos(bsdf, wo, ls.wi) : vec3f{0, 0, 0};
-      tm.stop(prof_point, t0);
-      if (ls.pdf > 0) {
-        if (!is_black(fc)) {
-          st.shadow_rays++;
-          t0 = tm.start();
-          bool visible = unoccluded(in, sp, ls);
-          tm.stop(prof_shadow, t0);
-          if (visible) {
-            vec3f unweighted = fc * ls.le / ls.pdf;
-            float w = last ? 1.0f : power_heuristic(float(n_nee) * choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
-            vec3f add = beta * unweighted * (w * inv_n / choice.prob);
-            radiance += add;
-            value = luminance(unweighted) / choice.prob_in_cluster;
-            added = added_total = luminance(add);
-          }
+      vec3f unweighted_sum = {0, 0, 0}, add_sum = {0, 0, 0};
+      bool seen = false;  // a point was visible
+      double c_sum = 0, c_sq = 0;  // the points' contributions, each as a draw's only point (sample_info::within)
+      for (int j = 0; j < points; j++) {
+        t0 = tm.start();
+        float u = rk->u[dim_light_u], v = rk->u[dim_light_v];
+        if (points > 1) light_point_uv(points, j, u, v);
+        light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, u, v);
+        vec3f fc = ls.pdf > 0 ? eval_bsdf_cos(bsdf, wo, ls.wi) : vec3f{0, 0, 0};
+        tm.stop(prof_point, t0);
+        if (!(ls.pdf > 0) || is_black(fc)) continue;
+        st.shadow_rays++;
+        t0 = tm.start();
+        bool visible = unoccluded(in, sp, ls);
+        tm.stop(prof_shadow, t0);
+        if (!visible) continue;
+        seen = true;
+        vec3f unweighted = fc * ls.le / ls.pdf;
+        float w = last ? 1.0f : power_heuristic(nee_points * choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
+        vec3f one = beta * unweighted * (w * inv_n / choice.prob);
+        unweighted_sum += unweighted;
+        add_sum += one;
+        if (points > 1) {
+          double c = double(luminance(one));
+          c_sum += c, c_sq += c * c;
         }
+      }
+      if (points > 1) {
+        unweighted_sum = unweighted_sum * inv_points, add_sum = add_sum * inv_points;
+        // Sum of squared deviations from the mean, over points - 1 (clamped: rounding can leave it a hair below 0).
+        if (info) info->within += std::max(0.0, (c_sq - c_sum * c_sum / points) / (points - 1));
+      }
+      if (seen) {
+        radiance += add_sum;
+        value = luminance(unweighted_sum) / choice.prob_in_cluster;
+        added = added_total = luminance(add_sum);
       }
       if constexpr (has_control_variates<Sampler>::value) {
         // Control variate (unweighted NEE only): sum_j c_j + (Y_J - c_J) / P_J, the Y_J / P_J part added above;
@@ -289,6 +335,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     if (!go_on) break;
     prev_mis = true;
     prev_bsdf_pdf = bs.pdf;
+    prev_nee_points = nee_points;
     org = sp.p;  // continuation_hit starts the ray at the point itself
     dir = bs.wi;
     from_tri = h.tri, from_ng = sp.ng;
@@ -304,10 +351,10 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
 // trace_path_timed without timers, computing the pixel's streams itself (tests; renders compute them once per pixel).
 template <class Sampler, class Sink>
 vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample, path_stats& st,
-                 Sink& sink, typename Sampler::context (&ctxs)[2]) {
+                 Sink& sink, typename Sampler::context (&ctxs)[2], sample_info* info = nullptr) {
   no_timers tm;
   pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * in.camera.width + x));
-  return trace_path_timed(in, sampler, x, y, ps, sample, st, sink, ctxs, tm);
+  return trace_path_timed(in, sampler, x, y, ps, sample, st, sink, ctxs, tm, info);
 }
 
 }  // namespace bl

@@ -2,6 +2,7 @@
 #include "render.h"
 
 #include "file_io.h"
+#include "light_points.h"
 #include "progress.h"
 
 #include <tbb/blocked_range.h>
@@ -170,13 +171,23 @@ constexpr int rows_per_band() {
   else return 1;
 }
 
+// --light-points auto (light_points.h): what a pass gathers for the choice of point counts. The film before the
+// pass gives each pixel's mean; each image row sums its pixels' statistics, in pixel order, into its own slots (one
+// per tile of the row), which end_point_pass folds in row order.
+struct point_gather {
+  const std::vector<double>* film = nullptr;
+  double film_weight = 0;
+  std::vector<double> rows;  // height * point_tile_cols * point_stat_fields
+  int cols = 0;
+};
+
 // Renders samples [s0, s1) of every pixel into pass_sum; false when interrupted (the pass is then void). With
 // Profile, each row's stages are timed into rows.timers. extend: the samples go on from a run of the same pass
 // that ended at s0 (its sums, counters, timers and records are added to, not restarted).
 template <bool Profile, class Sampler, class Rows>
 bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, std::vector<double>& pass_sum,
               Rows& rows, tbb::task_arena& arena, progress_counters& progress, int raise_signals = 0,
-              bool extend = false) {
+              bool extend = false, point_gather* points = nullptr) {
   int w = in.camera.width, h = in.camera.height;
   std::atomic<bool> stopped{false};
   // Work items are bands of rows (one row for samplers without a row state shared by several rows): a band's rows
@@ -194,6 +205,11 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
             }
             path_stats& st = rows.stats[size_t(y)];
             if (!extend) st = {};
+            if (points && !extend) {
+              const size_t row = size_t(y) * size_t(points->cols) * point_stat_fields;
+              std::fill(points->rows.begin() + ptrdiff_t(row),
+                        points->rows.begin() + ptrdiff_t(row + size_t(points->cols) * point_stat_fields), 0.0);
+            }
             typename Sampler::context ctxs[2];
             std::conditional_t<Profile, cycle_timers, no_timers> tm;
             for (int x = 0; x < w; x++) {
@@ -201,10 +217,38 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
               // (Extended: the sums go on from the pass's earlier samples, added in the order one pass adds them.)
               double sum[3] = {extend ? out[0] : 0.0, extend ? out[1] : 0.0, extend ? out[2] : 0.0};
               const pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * w + x));
-              for (int s = s0; s < s1; s++) {
-                vec3f l = trace_path_timed(in, sampler, x, y, ps, uint64_t(s), st, sink, ctxs, tm);
-                sink.sample_done(y * w + x, l);
-                sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
+              if (!points) {
+                for (int s = s0; s < s1; s++) {
+                  vec3f l = trace_path_timed(in, sampler, x, y, ps, uint64_t(s), st, sink, ctxs, tm);
+                  sink.sample_done(y * w + x, l);
+                  sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
+                }
+              } else {
+                double* slot = &points->rows[(size_t(y) * size_t(points->cols) + size_t(x / point_tile_size)) *
+                                             point_stat_fields];
+                const bool has_mean = points->film_weight > 0;
+                double m = 0, g = 0;
+                if (has_mean) {
+                  const double* f = &(*points->film)[3 * (size_t(y) * w + x)];
+                  m = (0.2126 * f[0] + 0.7152 * f[1] + 0.0722 * f[2]) / points->film_weight;
+                  g = 1.0 / (m * m + 0.01);
+                }
+                for (int s = s0; s < s1; s++) {
+                  const uint64_t vertices = st.camera_rays + st.bounce_rays;
+                  sample_info info;
+                  vec3f l = trace_path_timed(in, sampler, x, y, ps, uint64_t(s), st, sink, ctxs, tm, &info);
+                  sink.sample_done(y * w + x, l);
+                  sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
+                  slot[ps_samples] += 1;
+                  slot[ps_vertices] += double(st.camera_rays + st.bounce_rays - vertices);
+                  if (has_mean) {
+                    const double d = 0.2126 * l.x + 0.7152 * l.y + 0.0722 * l.z - m;
+                    slot[ps_weight] += g;
+                    slot[ps_sq_dev] += g * d * d;
+                    slot[ps_inv_points] += g / info.points;
+                    if (info.points > 1) slot[ps_within] += g * info.within, slot[ps_within_weight] += g;
+                  }
+                }
               }
               out[0] = sum[0], out[1] = sum[1], out[2] = sum[2];
             }
@@ -262,6 +306,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   if (result.film.size() != n) {
     result.film.assign(n, 0.0);
     result.film_weight = 0;
+    result.point_stats.clear();
     result.spp = result.passes = 0;
   }
   const double weighting = adapts(sampler) ? params.pass_weighting : 0.0;
@@ -270,6 +315,20 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     if (result.spp == 0) sampler.restart_check();
   }
   std::vector<double> pass_sum(n, 0.0);
+  // --light-points auto: the tiles' statistics (kept with the film), this pass's rows of them, the tiles' counts.
+  const bool auto_points = params.light_points == 0;
+  const int tile_cols = point_tile_cols(w);
+  const size_t point_stats_size = size_t(tile_cols) * size_t(point_tile_rows(h)) * point_stat_fields;
+  point_gather gather;
+  std::vector<uint8_t> tile_points;
+  if (auto_points) {
+    if (result.point_stats.size() != point_stats_size) result.point_stats.assign(point_stats_size, 0.0);
+    gather.rows.assign(size_t(h) * size_t(tile_cols) * point_stat_fields, 0.0);
+    gather.cols = tile_cols;
+    gather.film = &result.film;
+  } else {
+    result.point_stats.clear();
+  }
   using rows_type = std::conditional_t<Sampler::learns, pass_rows<Sampler>, pass_rows_none>;
   rows_type rows;
   rows.stats.resize(size_t(h));
@@ -340,12 +399,20 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     render_inputs pin = in;
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
+    if (auto_points) {
+      choose_tile_points(result.point_stats, done, tile_points);
+      pin.point_tiles = tile_points.data();
+      pin.point_tile_cols = tile_cols;
+      gather.film_weight = result.film_weight;
+    }
+    point_gather* gathering = auto_points ? &gather : nullptr;
     int raise = pass == 0 && done == 0 ? params.signals_in_first_pass : 0;
     auto run_samples = [&](int s0, int s1, bool extend) {
       if (params.on_samples) params.on_samples(s1 - s0);
       auto run = [&](const auto& s) {
-        return params.profile ? run_pass<true>(pin, s, s0, s1, pass_sum, rows, arena, progress, raise, extend)
-                              : run_pass<false>(pin, s, s0, s1, pass_sum, rows, arena, progress, raise, extend);
+        return params.profile
+                   ? run_pass<true>(pin, s, s0, s1, pass_sum, rows, arena, progress, raise, extend, gathering)
+                   : run_pass<false>(pin, s, s0, s1, pass_sum, rows, arena, progress, raise, extend, gathering);
       };
       // A bayes sampler that fell back runs its passes as the power sampler itself: the hot path has none of its
       // code.
@@ -382,6 +449,14 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     const double wk = pass_weight(done, weighting);
     for (size_t i = 0; i < n; i++) result.film[i] += wk * pass_sum[i];
     result.film_weight += wk * count;
+    if (auto_points)  // (in row order: a tile's rows one after another)
+      for (int y = 0; y < h; y++)
+        for (int tx = 0; tx < tile_cols; tx++) {
+          double* to = &result.point_stats[(size_t(y / point_tile_size) * size_t(tile_cols) + size_t(tx)) *
+                                           point_stat_fields];
+          const double* from = &gather.rows[(size_t(y) * size_t(tile_cols) + size_t(tx)) * point_stat_fields];
+          for (int f = 0; f < point_stat_fields; f++) to[f] += from[f];
+        }
     for (const path_stats& st : rows.stats) add_stats(result.stats, st);
     for (const cycle_timers& t : rows.timers)
       for (int c = 0; c < prof_count; c++) result.profile_cycles[c] += t.cycles[c];
@@ -498,6 +573,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
   in.seed = params.seed;
   in.stratify = params.stratify;
   in.nee_samples = std::max(1, params.light_samples);
+  in.light_points = std::max(1, params.light_points);
   int frames = std::max(1, params.frames);
   // The set-up (light tree, the regions of the first hits) runs on at most --threads threads too.
   int threads = params.threads > 0 ? params.threads : int(std::max(1u, std::thread::hardware_concurrency()));

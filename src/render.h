@@ -40,6 +40,7 @@ struct render_params {
   // times in the image (0: all alike). Fixed in advance, so the weighted mean stays unbiased.
   double pass_weighting = 4;
   int light_samples = 1;      // NEE samples per path vertex (render_inputs::nee_samples)
+  int light_points = 1;       // points per NEE draw at the first vertex (render_inputs::light_points); 0: auto
   bool stratify = true;       // stratified light and BSDF samples at the first vertex (integrator.h)
   // A signal arriving during the render's first pass (frame 0, not resumed) lets that pass finish, so that there is an
   // image to write, and the render then stops; a second one, half a second or more later, stops it at once. (The
@@ -75,6 +76,8 @@ struct render_result {
   int frame = 0;              // the animation frame (render_frames; a checkpoint of frame k resumes there)
   std::vector<double> film;   // per pixel RGB sums over all completed samples, each pass's times its weight
   double film_weight = 0;     // the sum of the weights of one pixel's samples (= spp when all weigh 1)
+  // --light-points auto: the tiles' statistics of the completed passes (light_points.h; empty otherwise).
+  std::vector<double> point_stats;
   int spp = 0;                // samples per pixel in the film
   int passes = 0;
   int stratum_base = 0;       // first sample of the stratified light set (integrator.h): the last change of model

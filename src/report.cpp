@@ -50,6 +50,11 @@ std::string render_summary(const render_result& r, const std::vector<std::string
     std::snprintf(buf, sizeof buf, "; %.1f%% of NEE samples contribute nothing", 100.0 * double(st.nee_zero) / double(st.nee_samples));
     s += buf;
   }
+  if (st.first_points > st.first_draws) {  // (--light-points above 1, or auto)
+    std::snprintf(buf, sizeof buf, "; %.2f light points per first-vertex NEE sample",
+                  double(st.first_points) / double(st.first_draws));
+    s += buf;
+  }
   if (r.regions > 0) {
     // One region: a cut shared by all (a handful of lights), which the bound sampler reads from the root alone.
     if (r.regions == 1)

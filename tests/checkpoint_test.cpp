@@ -38,7 +38,9 @@ TEST_CASE("interrupted and killed renders resume to the same bytes", "[checkpoin
   temp_dir d;
   // bayes in direct illumination too: there its clusters are refined into members (region_params::max_members).
   // (An oracle's frozen model does not adapt: its passes weigh alike, which the checkpoint check must know.)
-  for (const char* s : {"bound", "donikian", "bayes", "bayes --max-depth 1", "bayes --bayes-oracle 8"}) {
+  // --light-points auto: the tiles' statistics, which choose the next passes' point counts, come back with the film.
+  for (const char* s : {"bound", "donikian", "bayes", "bayes --max-depth 1", "bayes --bayes-oracle 8",
+                        "bayes --light-points auto", "power --max-depth 1 --light-points auto"}) {
     INFO(s);
     std::string full = d / "full.pfm";
     REQUIRE(run_bayeslight(base_args(s) + " -o " + full).status == 0);
@@ -273,7 +275,9 @@ TEST_CASE("resuming with other options or a corrupt checkpoint is refused", "[ch
         other_render{base_args("bound") + " --seed 5", "the seed, the sampler"},
         other_render{base_args("bayes") + " --bayes-b0 2", "the bayes options (--bayes-*)"},
         other_render{base_args("bayes") + " --light-samples 2",
-                     "the light samples (--independent-samples, --light-samples)"},
+                     "the light samples (--independent-samples, --light-samples, --light-points)"},
+        other_render{base_args("bayes") + " --light-points auto",
+                     "the light samples (--independent-samples, --light-samples, --light-points)"},
         other_render{base_args("bayes") + " --grid 32",  // (16 is the automatic grid at 40x30)
                      "the region options (--grid, --max-cut, --cut-*, --region-*, --shared-cut-lights, --fine-depth)"},
         // (the automatic pair budget follows the image size: the region options are not named too)
@@ -375,7 +379,7 @@ constexpr size_t pass_record_bytes = 4 + 4 + 8 + 1 + 3 * 8;
 
 // Offsets of the fields the test edits.
 struct checkpoint_fields {
-  size_t passes, log, film, film_weight, cut_nodes, pair_parent, pending, pending_slots, pending_count, moments;
+  size_t passes, log, film, film_weight, point_stats, cut_nodes, pair_parent, pending, pending_slots, pending_count, moments;
   size_t regions, regions_end;  // the region state: from its first column to the end of its pending table
   uint64_t parents = 0;  // entries of the pair_parent column
 };
@@ -383,11 +387,12 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   checkpoint_fields f{};
   c.pos = checkpoint_frame_offset;  // (a still's checkpoint has no frame index: its passes follow)
   f.passes = c.value(4);
-  c.value(4 + 4 + 8 + 6 * 8);  // spp, stratum base, seconds, counters
+  c.value(4 + 4 + 8 + 8 * 8);  // spp, stratum base, seconds, counters
   uint64_t log = c.get<uint64_t>(c.value(8));
   f.log = c.value(log * pass_record_bytes);
   f.film = c.column(8);
   f.film_weight = c.value(8);
+  f.point_stats = c.column(8);  // (--light-points auto's; empty otherwise)
   f.regions = c.pos;
   for (int k = 0; k < 5; k++) c.column(k == 0 ? 8 : 4);  // key, cut_offset, cut_size, pair_offset, parent
   f.cut_nodes = c.column(4);

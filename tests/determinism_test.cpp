@@ -57,9 +57,30 @@ TEST_CASE("one and two threads give byte identical files for every sampler", "[d
   }
 }
 
+TEST_CASE("light points chosen per tile give byte identical files on one and two threads", "[determinism]") {
+  // --light-points auto: each tile's statistics are summed in pixel and row order, and read between passes only. 24
+  // spp: past the exploration (8 spp), so tiles choose counts other than 2 (the summary's mean says they did).
+  temp_dir d;
+  for (const char* scene : {"data/plant_room/direct.json", "data/living_room/path.json"})
+    for (const char* s : {"bayes", "bound"}) {
+      std::string a = d / "a.pfm", b = d / "b.pfm";
+      const std::string args = std::string(s) + " --light-points auto --spp 24";
+      auto r1 = run_bayeslight(render_args(args, "--threads 1 -o " + a, scene));
+      // (Without --quiet: the summary.)
+      auto r2 = run_bayeslight("render " + source_path(scene) + " --width 40 --height 30 --sampler " + args +
+                               " --threads 2 -o " + b);
+      INFO(scene << " " << s << "\n" << r1.output << r2.output);
+      REQUIRE(r1.status == 0);
+      REQUIRE(r2.status == 0);
+      CHECK(read_file(a) == read_file(b));
+      CHECK(r2.output.find(" light points per first-vertex NEE sample") != std::string::npos);
+      CHECK(r2.output.find("; 2.00 light points per first-vertex NEE sample") == std::string::npos);
+    }
+}
+
 TEST_CASE("a time budget run equals the spp run of the same sample count", "[determinism]") {
   temp_dir d;
-  for (const char* s : {"power", "bound", "donikian", "bayes"}) {
+  for (const char* s : {"power", "bound", "donikian", "bayes", "bayes --light-points auto"}) {
     std::string t = d / "t.pfm", n = d / "n.pfm", log = d / "t.csv";
     auto rt = run_bayeslight(render_args(s, "--time 0.3 --threads 2 -o " + t + " --log " + log));
     INFO(s << "\n" << rt.output);
