@@ -42,9 +42,10 @@ void add_render_options(CLI::App* r, render_options& o) {
           throw CLI::ValidationError("--light-points", "must be auto or an integer from 1 to 64 (got " + s + ")");
         o.light_points = int(v);
       },
-      "Points on the chosen light at the first vertex, each with its shadow ray, averaged: they cut the variance "
-      "inside the light (a lamp half hidden by leaves) for less than whole samples cost; auto: 1, 2, 3, 5 or 8 per "
-      "8x8-pixel tile, chosen between passes from the variance and cost the tile measured (default 1)")
+      "Points on the chosen light at the first vertex, each with its shadow ray, averaged: they cut the noise inside "
+      "the light (a lamp half hidden by leaves) for less than whole samples cost. auto: 1, 2, 3, 5 or 8 per 8x8-pixel "
+      "tile, chosen between passes from the noise and cost each tile measured, where they cut the image's error per "
+      "second most (default auto)")
       ->type_name("auto|N");
   r->add_option("--threads", o.threads, "Worker threads (default: all cores); never changes the image")
       ->check(CLI::Range(1, 4096));

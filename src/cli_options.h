@@ -43,7 +43,7 @@ struct render_options {
   double pass_weighting = 4;
   bool independent = false;
   int light_samples = 1;
-  int light_points = 1;  // --light-points (0: auto)
+  int light_points = 0;  // --light-points (0: auto, the default)
   std::string checkpoint;
   double checkpoint_every = 30;
   std::string resume;

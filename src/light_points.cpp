@@ -24,31 +24,63 @@ void light_point_uv(int points, int j, float& u, float& v) {
   v = wrap01(v + float(int((int64_t(j) * g) % points)) / float(points));
 }
 
-int choose_light_points(const double* s) {
-  if (!(s[ps_samples] > 0 && s[ps_weight] > 0 && s[ps_within_weight] > 0)) return 1;
-  const double within = s[ps_within] / s[ps_within_weight];
-  const double total = s[ps_sq_dev] / s[ps_weight];
-  // What the rest of the sample adds (camera jitter, the light choice, the path past the first vertex); the samples'
+tile_measure measure_tile(const double* s) {
+  tile_measure m;
+  if (!(s[ps_samples] > 0 && s[ps_mean_samples] > 0 && s[ps_within_samples] > 0)) return m;
+  m.within = s[ps_within] / s[ps_within_samples];
+  const double total = s[ps_sq_dev] / s[ps_mean_samples];
+  m.cost = point_cost_per_vertex * s[ps_vertices] / s[ps_samples];
+  m.samples = s[ps_mean_samples];
+  if (!(m.within >= 0) || !(m.cost > 0) || !std::isfinite(m.within + total + m.cost + s[ps_inv_points])) return m;
+  // What the rest of the sample adds (camera jitter, the light choice, the path past the first vertex): the samples'
   // mix of point counts weighs the within part they had. Noise can take the difference below zero.
-  const double cost = point_cost_per_vertex * s[ps_vertices] / s[ps_samples];
-  if (!(within > 0) || !(cost > 0) || !std::isfinite(within + total + cost + s[ps_inv_points])) return 1;
-  const double rest = std::max(0.0, total - within * s[ps_inv_points] / s[ps_weight]);
+  m.rest = std::max(0.0, total - m.within * s[ps_inv_points] / s[ps_mean_samples]);
+  m.ok = true;
+  return m;
+}
+
+int best_points(double within, double rest, double lambda) {
   static const int candidates[] = {1, 2, 3, 5, 8};
   int best = 1;
-  double best_work = (cost) * (rest + within);
+  double best_value = rest + within;
   for (int k : candidates) {
     if (k > max_auto_points) break;
-    const double work = (cost + double(k - 1)) * (rest + within / double(k));
-    if (work < best_work) best = k, best_work = work;
+    const double value = rest + within / double(k) + lambda * double(k - 1);
+    if (value < best_value) best = k, best_value = value;
   }
   return best;
 }
 
-void choose_tile_points(const std::vector<double>& stats, int spp, std::vector<uint8_t>& points) {
+void choose_tile_points(const std::vector<double>& stats, int spp, int pass, std::vector<uint8_t>& points) {
   const size_t tiles = stats.size() / point_stat_fields;
-  points.resize(tiles);
+  points.assign(tiles, uint8_t(spp < point_explore_spp ? point_explore_points : 1));
+  if (spp < point_explore_spp) return;
+  std::vector<tile_measure> m(tiles);
+  for (size_t t = 0; t < tiles; t++) m[t] = measure_tile(&stats[t * point_stat_fields]);
+  // The image's error and cost per sample at the counts best_points gives for lambda (sums in tile order).
+  std::vector<uint8_t> trial(tiles, 1);
+  auto allocate = [&](double lambda, double& error, double& cost) {
+    error = cost = 0;
+    for (size_t t = 0; t < tiles; t++)
+      if (m[t].ok) {
+        trial[t] = uint8_t(best_points(m[t].within, m[t].rest, lambda));
+        error += m[t].samples * (m[t].rest + m[t].within / trial[t]);
+        cost += m[t].samples * (m[t].cost + trial[t] - 1);
+      }
+  };
+  // lambda over a geometric range around the error per cost at one point everywhere (from about 1/1000 of it up to
+  // 8 times): the counts of the lambda whose error times cost is least.
+  double error = 0, cost = 0;
+  allocate(INFINITY, error, cost);
+  if (!(cost > 0 && error > 0) || !std::isfinite(error * cost)) return;
+  const double lambda1 = error / cost;
+  double best = error * cost;
+  for (int j = -20; j <= 6; j++) {
+    allocate(lambda1 * std::exp2(0.5 * j), error, cost);
+    if (error * cost < best) best = error * cost, points = trial;
+  }
   for (size_t t = 0; t < tiles; t++)
-    points[t] = uint8_t(spp < point_explore_spp ? point_explore_points : choose_light_points(&stats[t * point_stat_fields]));
+    if (points[t] == 1 && (t + size_t(pass)) % point_reexplore_passes == 0) points[t] = 2;
 }
 
 }  // namespace bl

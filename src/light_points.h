@@ -20,6 +20,10 @@ constexpr int point_tile_size = 8;     // pixels along a tile's side (--light-po
 constexpr int point_explore_spp = 8;   // auto: samples per pixel drawn with explore_points before choosing
 constexpr int point_explore_points = 2;
 constexpr int max_auto_points = 8;
+constexpr size_t point_reexplore_passes = 8;  // auto: a tile at one point takes two on one pass in this many
+// The tiles' statistics are scaled by this at every pass's end before its own are added: the choice follows what the
+// latest passes measured (an adaptive sampler's variance falls as it learns).
+constexpr double point_stats_decay = 0.5;
 // The cost of a path vertex (camera or continuation ray, shading, the light choice, one point and its shadow ray) in
 // extra light points (a point, the BSDF at it, a shadow ray). Measured with --profile: an extra point cost about a
 // quarter of a direct-lighting sample in the plant room and the living room (bayes and bound).
@@ -32,27 +36,39 @@ void light_point_uv(int points, int j, float& u, float& v);
 // Per-tile statistics, point_stat_fields doubles per tile. Samples are weighted by g = 1 / (m^2 + 0.01), m the
 // pixel's luminance mean before the pass (relMSE's weight, SPEC.md §6), and counted only once the pixel has a mean.
 enum point_stat_field {
-  ps_samples,     // samples (unweighted)
-  ps_vertices,    // path vertices of those samples (camera and continuation rays)
-  ps_weight,      // sum of g
-  ps_sq_dev,      // sum of g (y - m)^2, y the sample's luminance
-  ps_inv_points,  // sum of g / K
-  ps_within,      // sum of g * sample_info::within, over samples of K >= 2
-  ps_within_weight,  // sum of g over those samples
+  ps_samples,         // samples (all)
+  ps_vertices,        // path vertices of those samples (camera and continuation rays)
+  ps_mean_samples,    // samples of pixels with a mean
+  ps_sq_dev,          // sum of g (y - m)^2 n / (n + 1) over those, y the sample's luminance, n the mean's samples
+  ps_inv_points,      // sum of 1 / K over those
+  ps_within,          // sum of g * sample_info::within over those of K >= 2
+  ps_within_samples,  // how many those are
   point_stat_fields
 };
 
-// The number of points (1, 2, 3, 5 or 8) that minimises cost times variance per sample, where a sample of K points
-// costs c + K - 1 (c: its vertices times point_cost_per_vertex) and has variance v_rest + v_within / K; 1 without
-// data. `s` holds one tile's point_stat_fields.
-int choose_light_points(const double* s);
+// What a tile measured, per sample (relMSE-weighted variances): the variance inside the chosen lights at one point,
+// the rest, and the cost in extra points (path vertices times point_cost_per_vertex). ok = false without data (or
+// with non-finite sums): such a tile keeps one point.
+struct tile_measure {
+  double within = 0, rest = 0, cost = 0, samples = 0;
+  bool ok = false;
+};
+tile_measure measure_tile(const double* s);
+
+// The count (1, 2, 3, 5 or 8) that minimises rest + within / K + lambda (K - 1): a tile's share of the image's error
+// plus lambda times its share of the render's time. lambda is the image's error per unit of time, so the choice
+// minimises error times time for the whole image, whose tiles share one sample count (a tile whose own samples are
+// cheap to improve but add little error gets fewer points than its own efficiency would ask).
+int best_points(double within, double rest, double lambda);
 
 // The tile counts of an image.
 inline int point_tile_cols(int width) { return (width + point_tile_size - 1) / point_tile_size; }
 inline int point_tile_rows(int height) { return (height + point_tile_size - 1) / point_tile_size; }
 
-// Every tile's count for the next pass, given `spp` samples per pixel done: point_explore_points before
-// point_explore_spp, then choose_light_points.
-void choose_tile_points(const std::vector<double>& stats, int spp, std::vector<uint8_t>& points);
+// Every tile's count for the next pass (pass `pass`, `spp` samples per pixel done): point_explore_points before
+// point_explore_spp; then best_points for the lambda (of a geometric range) whose counts give the image the least
+// error times cost. A tile at one point takes two on one pass in point_reexplore_passes (by tile and pass), so that
+// what it measures inside its lights stays current.
+void choose_tile_points(const std::vector<double>& stats, int spp, int pass, std::vector<uint8_t>& points);
 
 }  // namespace bl

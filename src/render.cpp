@@ -177,6 +177,7 @@ constexpr int rows_per_band() {
 struct point_gather {
   const std::vector<double>* film = nullptr;
   double film_weight = 0;
+  double mean_samples = 0;   // samples per pixel before the pass
   std::vector<double> rows;  // height * point_tile_cols * point_stat_fields
   int cols = 0;
 };
@@ -227,11 +228,13 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                 double* slot = &points->rows[(size_t(y) * size_t(points->cols) + size_t(x / point_tile_size)) *
                                              point_stat_fields];
                 const bool has_mean = points->film_weight > 0;
-                double m = 0, g = 0;
+                double m = 0, g = 0, mean_noise = 1;
                 if (has_mean) {
                   const double* f = &(*points->film)[3 * (size_t(y) * w + x)];
                   m = (0.2126 * f[0] + 0.7152 * f[1] + 0.0722 * f[2]) / points->film_weight;
+                  // (A mean of n earlier samples adds V / n to E (y - m)^2: n / (n + 1) takes it out.)
                   g = 1.0 / (m * m + 0.01);
+                  mean_noise = points->mean_samples / (points->mean_samples + 1);
                 }
                 for (int s = s0; s < s1; s++) {
                   const uint64_t vertices = st.camera_rays + st.bounce_rays;
@@ -243,10 +246,10 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                   slot[ps_vertices] += double(st.camera_rays + st.bounce_rays - vertices);
                   if (has_mean) {
                     const double d = 0.2126 * l.x + 0.7152 * l.y + 0.0722 * l.z - m;
-                    slot[ps_weight] += g;
-                    slot[ps_sq_dev] += g * d * d;
-                    slot[ps_inv_points] += g / info.points;
-                    if (info.points > 1) slot[ps_within] += g * info.within, slot[ps_within_weight] += g;
+                    slot[ps_mean_samples] += 1;
+                    slot[ps_sq_dev] += g * mean_noise * d * d;
+                    slot[ps_inv_points] += 1.0 / info.points;
+                    if (info.points > 1) slot[ps_within] += g * info.within, slot[ps_within_samples] += 1;
                   }
                 }
               }
@@ -400,10 +403,11 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
     if (auto_points) {
-      choose_tile_points(result.point_stats, done, tile_points);
+      choose_tile_points(result.point_stats, done, pass, tile_points);
       pin.point_tiles = tile_points.data();
       pin.point_tile_cols = tile_cols;
       gather.film_weight = result.film_weight;
+      gather.mean_samples = done;
     }
     point_gather* gathering = auto_points ? &gather : nullptr;
     int raise = pass == 0 && done == 0 ? params.signals_in_first_pass : 0;
@@ -449,7 +453,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     const double wk = pass_weight(done, weighting);
     for (size_t i = 0; i < n; i++) result.film[i] += wk * pass_sum[i];
     result.film_weight += wk * count;
-    if (auto_points)  // (in row order: a tile's rows one after another)
+    if (auto_points) {  // (in row order: a tile's rows one after another)
+      for (double& x : result.point_stats) x *= point_stats_decay;
       for (int y = 0; y < h; y++)
         for (int tx = 0; tx < tile_cols; tx++) {
           double* to = &result.point_stats[(size_t(y / point_tile_size) * size_t(tile_cols) + size_t(tx)) *
@@ -457,6 +462,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
           const double* from = &gather.rows[(size_t(y) * size_t(tile_cols) + size_t(tx)) * point_stat_fields];
           for (int f = 0; f < point_stat_fields; f++) to[f] += from[f];
         }
+    }
     for (const path_stats& st : rows.stats) add_stats(result.stats, st);
     for (const cycle_timers& t : rows.timers)
       for (int c = 0; c < prof_count; c++) result.profile_cycles[c] += t.cycles[c];

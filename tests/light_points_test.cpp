@@ -40,86 +40,109 @@ TEST_CASE("a draw's light points take one row and one column each of a K by K gr
 }
 
 namespace {
-// One tile's statistics for samples of `points` points whose per-sample variance at one point is rest + within, of
-// `vertices` path vertices each (n samples, weight 1).
+// One tile's statistics for n samples of `points` points, each of weight g = 1, whose variance at one point is
+// rest + within, of `vertices` path vertices each.
 std::vector<double> tile_stats(double rest, double within, double vertices, int points, double n = 1000) {
   std::vector<double> s(point_stat_fields, 0.0);
   s[ps_samples] = n;
   s[ps_vertices] = n * vertices;
-  s[ps_weight] = n;
+  s[ps_mean_samples] = n;
   s[ps_sq_dev] = n * (rest + within / points);
   s[ps_inv_points] = n / points;
-  if (points > 1) s[ps_within] = n * within, s[ps_within_weight] = n;
+  if (points > 1) s[ps_within] = n * within, s[ps_within_samples] = n;
   return s;
 }
-int brute_force(double rest, double within, double vertices) {
-  int best = 1;
-  double best_work = INFINITY;
-  for (int k : {1, 2, 3, 5, 8}) {
-    double work = (point_cost_per_vertex * vertices + k - 1) * (rest + within / k);
-    if (work < best_work) best = k, best_work = work;
-  }
-  return best;
+void add_to(std::vector<double>& a, const std::vector<double>& b) {
+  for (size_t f = 0; f < a.size(); f++) a[f] += b[f];
 }
 }  // namespace
 
-TEST_CASE("the point count minimises cost times variance from what a tile measured", "[light_points]") {
-  // Direct lighting (one vertex) where the variance inside the light is 85 % of a one-point sample's (the plant room's
-  // measured share): 5 points. Nothing inside the lights: 1. Nothing but: 8. Path traced (5 vertices), the same
-  // split costs relatively less: more points. Every case against the brute-force minimum, from statistics gathered
-  // at 2 points (the exploration) and at 5.
-  struct variant {
-    double rest, within, vertices;
-    int expected;
-  };
-  for (const variant& v : {variant{0.15, 0.85, 1, 5}, variant{1.0, 0.0, 1, 1}, variant{0.0, 1.0, 1, 8},
-                           variant{0.9, 0.1, 1, 1}, variant{0.5, 0.5, 1, 2}, variant{0.5, 0.5, 5, 5}}) {
-    INFO("rest " << v.rest << " within " << v.within << " vertices " << v.vertices);
-    CHECK(brute_force(v.rest, v.within, v.vertices) == v.expected);
-    for (int gathered_at : {2, 5})
-      CHECK(choose_light_points(tile_stats(v.rest, v.within, v.vertices, gathered_at).data()) == v.expected);
-  }
-  // Statistics of several passes of different counts add up to the same answer.
-  std::vector<double> a = tile_stats(0.15, 0.85, 1, 2), b = tile_stats(0.15, 0.85, 1, 5, 3000),
-                      c = tile_stats(0.15, 0.85, 1, 1, 500);
-  for (int f = 0; f < point_stat_fields; f++) a[size_t(f)] += b[size_t(f)] + c[size_t(f)];
-  CHECK(choose_light_points(a.data()) == 5);
+TEST_CASE("a tile's measures come back from its sums, whatever mix of point counts made them", "[light_points]") {
+  // Passes at 2, 5 and 1 points: the part inside the lights is measured at 2 and 5 only, and the rest is what the
+  // total leaves at each pass's count.
+  std::vector<double> s = tile_stats(0.15, 0.85, 3, 2);
+  add_to(s, tile_stats(0.15, 0.85, 3, 5, 3000));
+  add_to(s, tile_stats(0.15, 0.85, 3, 1, 500));
+  tile_measure m = measure_tile(s.data());
+  REQUIRE(m.ok);
+  CHECK(m.within == Approx(0.85));
+  CHECK(m.rest == Approx(0.15));
+  CHECK(m.cost == Approx(3 * point_cost_per_vertex));
+  CHECK(m.samples == 4500);
 }
 
-TEST_CASE("the point count is one without data, and stays finite-safe", "[light_points]") {
-  std::vector<double> none(point_stat_fields, 0.0);
-  CHECK(choose_light_points(none.data()) == 1);
+TEST_CASE("a tile without data or with non-finite sums keeps one point", "[light_points]") {
+  CHECK(!measure_tile(std::vector<double>(point_stat_fields, 0.0).data()).ok);
   // Samples but never two points (nothing measured inside the lights).
-  CHECK(choose_light_points(tile_stats(0.2, 0.8, 1, 1).data()) == 1);
-  // Only camera rays that met nothing (no vertex cost is zero): 1.
+  CHECK(!measure_tile(tile_stats(0.2, 0.8, 1, 1).data()).ok);
+  // Only camera rays that met nothing: no vertex, no cost.
   std::vector<double> s = tile_stats(0.2, 0.8, 1, 2);
   s[ps_vertices] = 0;
-  CHECK(choose_light_points(s.data()) == 1);
-  // Non-finite sums (a tile whose statistics overflowed): 1.
-  s = tile_stats(0.2, 0.8, 1, 2);
-  s[ps_within] = INFINITY;
-  CHECK(choose_light_points(s.data()) == 1);
-  s = tile_stats(0.2, 0.8, 1, 2);
-  s[ps_sq_dev] = NAN;
-  CHECK(choose_light_points(s.data()) == 1);
-  // A total below the within part (noise): the rest counts as zero, all points.
+  CHECK(!measure_tile(s.data()).ok);
+  for (point_stat_field f : {ps_within, ps_sq_dev, ps_inv_points, ps_vertices})
+    for (double bad : {double(INFINITY), double(NAN)}) {
+      s = tile_stats(0.2, 0.8, 1, 2);
+      s[f] = bad;
+      INFO("field " << int(f) << " = " << bad);
+      CHECK(!measure_tile(s.data()).ok);
+    }
+  // A total below the within part (noise): the rest counts as zero.
   s = tile_stats(0.0, 1.0, 1, 2);
   s[ps_sq_dev] *= 0.5;
-  CHECK(choose_light_points(s.data()) == 8);
+  CHECK(measure_tile(s.data()).ok);
+  CHECK(measure_tile(s.data()).rest == 0);
+  // The choice over the whole image gives such tiles one point (their tiles' data are left out of lambda).
+  std::vector<double> stats = tile_stats(0.2, 0.8, 1, 1);
+  std::vector<uint8_t> points;
+  choose_tile_points(stats, 100, 1, points);
+  CHECK(int(points[0]) == 1);
 }
 
-TEST_CASE("tiles explore with two points for the first samples, then choose", "[light_points]") {
-  std::vector<double> stats = tile_stats(0.15, 0.85, 1, 2);
-  std::vector<double> flat = tile_stats(1, 0, 1, 2);
-  stats.insert(stats.end(), flat.begin(), flat.end());
+TEST_CASE("the point count minimises error plus lambda times cost", "[light_points]") {
+  // Against the brute-force minimum of rest + within / K + lambda (K - 1) over 1, 2, 3, 5, 8.
+  for (double within : {0.0, 0.01, 0.1, 0.5, 0.85, 1.0, 10.0})
+    for (double rest : {0.0, 0.15, 1.0})
+      for (double lambda : {0.0, 0.001, 0.02, 0.1, 1.0}) {
+        int best = 1;
+        double best_value = rest + within;
+        for (int k : {2, 3, 5, 8})
+          if (rest + within / k + lambda * (k - 1) < best_value) best = k, best_value = rest + within / k + lambda * (k - 1);
+        INFO("within " << within << " rest " << rest << " lambda " << lambda);
+        CHECK(best_points(within, rest, lambda) == best);
+      }
+  CHECK(best_points(1, 0, 0) == 8);   // free points: all of them
+  CHECK(best_points(0, 1, 0) == 1);   // nothing inside the lights to average
+  CHECK(best_points(0.85, 0.15, 1) == 1);  // points dear against the image's error
+}
+
+TEST_CASE("tiles share one sample count: points go where the image's error is", "[light_points]") {
+  // Two tiles of the same share inside the lights (85 %), one with 100 times the other's error: one sample count for
+  // both, so the points go to the first; at that spp the second's error hardly counts. (Each tile alone, by its own
+  // error times cost, would take 5 points.) Before point_explore_spp, every tile takes point_explore_points.
+  std::vector<double> stats = tile_stats(15, 85, 1, 2);
+  const std::vector<double> quiet = tile_stats(0.15, 0.85, 1, 2);
+  stats.insert(stats.end(), quiet.begin(), quiet.end());
   std::vector<uint8_t> points;
   for (int spp = 0; spp < point_explore_spp; spp++) {
-    choose_tile_points(stats, spp, points);
+    choose_tile_points(stats, spp, spp, points);
     REQUIRE(points.size() == 2);
-    CHECK(points[0] == point_explore_points);
-    CHECK(points[1] == point_explore_points);
+    CHECK(int(points[0]) == point_explore_points);
+    CHECK(int(points[1]) == point_explore_points);
   }
-  choose_tile_points(stats, point_explore_spp, points);
-  CHECK(points[0] == 5);
-  CHECK(points[1] == 1);
+  // (Passes 9 and 10: tile 1 is not the tile of a re-exploring pass in either.)
+  for (int pass : {9, 10}) {
+    choose_tile_points(stats, 100, pass, points);
+    INFO("pass " << pass);
+    CHECK(int(points[0]) >= 5);
+    CHECK(int(points[1]) == 1);
+  }
+  // A tile at one point takes two on one pass in point_explore_passes, by tile and pass.
+  choose_tile_points(stats, 100, int(point_reexplore_passes) - 1, points);
+  CHECK(int(points[1]) == 2);
+  // Alike tiles of equal error and share: both 5 (alone or together).
+  std::vector<double> twins = quiet;
+  twins.insert(twins.end(), quiet.begin(), quiet.end());
+  choose_tile_points(twins, 100, 10, points);
+  CHECK(int(points[0]) == 5);
+  CHECK(int(points[1]) == 5);
 }
