@@ -42,10 +42,10 @@ void add_render_options(CLI::App* r, render_options& o) {
           throw CLI::ValidationError("--light-points", "must be auto or an integer from 1 to 64 (got " + s + ")");
         o.light_points = int(v);
       },
-      "Points on the chosen light at the first vertex, each with its shadow ray, averaged: they cut the noise inside "
-      "the light (a lamp half hidden by leaves) for less than whole samples cost. auto: 1, 2, 3, 5 or 8 per 8x8-pixel "
-      "tile, chosen between passes from the noise and cost each tile measured, where they cut the image's error per "
-      "second most (default auto)")
+      "Points (1 to 64) on the light a first-vertex NEE draw chose, each with its shadow ray, averaged: they cut the "
+      "noise inside that light (a lamp half hidden by leaves) for less than whole samples would cost. auto: 2 for the "
+      "first 8 spp, then 1, 2, 3, 5 or 8 per 8x8-pixel tile, chosen between passes from the noise and the cost (in "
+      "path vertices) each tile measured, for the least error times cost over the image (default auto)")
       ->type_name("auto|N");
   r->add_option("--threads", o.threads, "Worker threads (default: all cores); never changes the image")
       ->check(CLI::Range(1, 4096));

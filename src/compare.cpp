@@ -233,7 +233,7 @@ std::string comparison_summary(const compare_data& data, const compare_params& p
                        : format("Equal samples: %d spp per sampler and run", rp.spp);
   s += format(" | %dx%d pixels | max depth %d | ", rp.width, rp.height, rp.max_depth);
   if (rp.light_samples > 1) s += format("%d light samples per vertex | ", rp.light_samples);
-  if (rp.light_points > 0) s += format("%d light point%s per first-vertex sample | ", rp.light_points,
+  if (rp.light_points > 0) s += format("%d light point%s per first-vertex NEE draw | ", rp.light_points,
                                        rp.light_points == 1 ? "" : "s");
   const uint64_t last_seed = rp.seed + uint64_t(p.runs - 1);  // (consecutive seeds wrap past 2^64 - 1 to 0)
   s += p.runs == 1 ? format("1 run (seed %llu)", (unsigned long long)rp.seed)

@@ -58,8 +58,9 @@ struct render_inputs {
 // What one sample reports beside its radiance (the choice of light points, light_points.h).
 struct sample_info {
   // Sum over the first vertex's NEE draws of the sample variance of their points' contributions (each taken as if it
-  // were the draw's only point): an unbiased estimate of what the variance inside the chosen lights adds to a sample
-  // of one point per draw. 0 with one point.
+  // were the draw's only point): what the variance inside the chosen lights adds to a sample of one point per draw
+  // (unbiased for independent points; the lattice's points, spread more evenly, make it an overestimate). 0 with one
+  // point.
   double within = 0;
   int points = 1;  // light points per draw at the first vertex
 };
@@ -217,6 +218,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       break;
     }
     vertex_randoms r = draw_vertex(key, uint32_t(depth));
+    // (The light point's own numbers, before stratification: --light-points auto's points, below.)
+    const float fresh_u = r.u[dim_light_u], fresh_v = r.u[dim_light_v];
     bool last = depth >= in.max_depth;
     if (depth == 1 && in.stratify)
       stratify_sample(ps, sample, in.stratum_base, last, r);
@@ -235,16 +238,28 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
 
     // Next-event estimation: nee_samples draws, each its own light choice and shadow ray, and at the first vertex
     // `points` points on the chosen light (a shifted lattice, light_point_uv), each with its shadow ray.
+    // --light-points auto chooses a pixel's count from what earlier samples measured, its own among them; the
+    // stratified light point of a sample depends on the set's earlier points, so a count chosen from their outcomes
+    // would bias the estimate (as a model learned from them would: the light sets restart when a model changes). So
+    // under auto the points start from the sample's own unstratified numbers, and MIS weighs them as one point per
+    // draw (both sides): given the light chosen, each count then has the same expectation, which no choice of count
+    // can tilt. The light choice, the BSDF direction and the camera jitter stay stratified.
     const int n_nee = in.nee_samples;
     const int points = depth == 1 ? points1 : 1;
+    const bool chosen_points = depth == 1 && in.point_tiles != nullptr;
     const float inv_n = 1.0f / float(n_nee), inv_points = 1.0f / float(points);
-    const float nee_points = float(n_nee) * float(points);
+    const float nee_points = float(n_nee) * float(chosen_points ? 1 : points);
     for (int k = 0; k < n_nee; k++) {
       vertex_randoms rk_own;
       const vertex_randoms* rk = &r;
+      float point_u = fresh_u, point_v = fresh_v;
       if (n_nee > 1) {
-        if (k > 0) rk_own = draw_vertex(key, uint32_t(depth) | (uint32_t(k) << 20)), rk = &rk_own;
-        else rk_own = r, rk = &rk_own;
+        if (k > 0) {
+          rk_own = draw_vertex(key, uint32_t(depth) | (uint32_t(k) << 20)), rk = &rk_own;
+          point_u = rk_own.u[dim_light_u], point_v = rk_own.u[dim_light_v];
+        } else {
+          rk_own = r, rk = &rk_own;
+        }
         if (depth == 1 && in.stratify)
           stratify_light_with(ps.strata, uint32_t((sample - in.stratum_base) * uint64_t(n_nee) + uint64_t(k)), rk_own);
       }
@@ -261,7 +276,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       double c_sum = 0, c_sq = 0;  // the points' contributions, each as a draw's only point (sample_info::within)
       for (int j = 0; j < points; j++) {
         t0 = tm.start();
-        float u = rk->u[dim_light_u], v = rk->u[dim_light_v];
+        float u = chosen_points ? point_u : rk->u[dim_light_u], v = chosen_points ? point_v : rk->u[dim_light_v];
         if (points > 1) light_point_uv(points, j, u, v);
         light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, u, v);
         vec3f fc = ls.pdf > 0 ? eval_bsdf_cos(bsdf, wo, ls.wi) : vec3f{0, 0, 0};

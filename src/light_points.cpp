@@ -40,7 +40,7 @@ tile_measure measure_tile(const double* s) {
 }
 
 int best_points(double within, double rest, double lambda) {
-  static const int candidates[] = {1, 2, 3, 5, 8};
+  static const int candidates[] = {2, 3, 5, 8};
   int best = 1;
   double best_value = rest + within;
   for (int k : candidates) {
@@ -51,7 +51,7 @@ int best_points(double within, double rest, double lambda) {
   return best;
 }
 
-void choose_tile_points(const std::vector<double>& stats, int spp, int pass, std::vector<uint8_t>& points) {
+void choose_tile_points(const std::vector<double>& stats, int spp, int pass, int draws, std::vector<uint8_t>& points) {
   const size_t tiles = stats.size() / point_stat_fields;
   points.assign(tiles, uint8_t(spp < point_explore_spp ? point_explore_points : 1));
   if (spp < point_explore_spp) return;
@@ -63,15 +63,15 @@ void choose_tile_points(const std::vector<double>& stats, int spp, int pass, std
     error = cost = 0;
     for (size_t t = 0; t < tiles; t++)
       if (m[t].ok) {
-        trial[t] = uint8_t(best_points(m[t].within, m[t].rest, lambda));
+        trial[t] = uint8_t(best_points(m[t].within, m[t].rest, lambda * draws));
         error += m[t].samples * (m[t].rest + m[t].within / trial[t]);
-        cost += m[t].samples * (m[t].cost + trial[t] - 1);
+        cost += m[t].samples * (m[t].cost + draws * (trial[t] - 1));
       }
   };
   // lambda over a geometric range around the error per cost at one point everywhere (from about 1/1000 of it up to
   // 8 times): the counts of the lambda whose error times cost is least.
   double error = 0, cost = 0;
-  allocate(INFINITY, error, cost);
+  allocate(INFINITY, error, cost);  // (one point everywhere: best_points compares no value above rest + within)
   if (!(cost > 0 && error > 0) || !std::isfinite(error * cost)) return;
   const double lambda1 = error / cost;
   double best = error * cost;

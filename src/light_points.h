@@ -6,8 +6,10 @@
 // points), the sample's whole variance, and the sample's cost counted in path vertices (deterministic, so the choice
 // never depends on timing or threads).
 // Invariants: each point is uniform over the light's (u, v) square (a lattice shifted by the draw's own point), so
-// every K gives an unbiased estimate; the statistics are summed in pixel order within a row and in row order within
-// a tile, and are only read between passes.
+// a fixed K gives an unbiased estimate; under auto, whose counts depend on a pixel's own earlier samples, the points
+// start from the sample's unstratified numbers and MIS counts one point per draw (integrator.h), so that the choice
+// of count cannot tilt the estimate either; the statistics are summed in pixel order within a row and in row order
+// within a tile, and are only read between passes.
 #pragma once
 
 #include <cstddef>
@@ -65,10 +67,11 @@ int best_points(double within, double rest, double lambda);
 inline int point_tile_cols(int width) { return (width + point_tile_size - 1) / point_tile_size; }
 inline int point_tile_rows(int height) { return (height + point_tile_size - 1) / point_tile_size; }
 
-// Every tile's count for the next pass (pass `pass`, `spp` samples per pixel done): point_explore_points before
+// Every tile's count for the next pass (pass `pass`, `spp` samples per pixel done, `draws` NEE draws per first vertex,
+// each paying K - 1 extra points): point_explore_points before
 // point_explore_spp; then best_points for the lambda (of a geometric range) whose counts give the image the least
 // error times cost. A tile at one point takes two on one pass in point_reexplore_passes (by tile and pass), so that
 // what it measures inside its lights stays current.
-void choose_tile_points(const std::vector<double>& stats, int spp, int pass, std::vector<uint8_t>& points);
+void choose_tile_points(const std::vector<double>& stats, int spp, int pass, int draws, std::vector<uint8_t>& points);
 
 }  // namespace bl

@@ -141,7 +141,7 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
        threads == 1 ? "" : "s");
   if (params.light_samples > 1) line(", %d light samples per vertex", params.light_samples);
   if (params.light_points > 0)
-    line(", %d light point%s per first-vertex sample", params.light_points, params.light_points == 1 ? "" : "s");
+    line(", %d light point%s per first-vertex NEE draw", params.light_points, params.light_points == 1 ? "" : "s");
   line("\n");
   double rays_total = double(st.camera_rays + st.shadow_rays + st.bounce_rays);
   line("  plain render: %.3f s in %d passes; %.3f M NEE samples (%.2f M/s); %.2f M rays/s (camera %.2f M, shadow "

@@ -403,7 +403,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
     if (auto_points) {
-      choose_tile_points(result.point_stats, done, pass, tile_points);
+      choose_tile_points(result.point_stats, done, pass, in.nee_samples, tile_points);
       pin.point_tiles = tile_points.data();
       pin.point_tile_cols = tile_cols;
       gather.film_weight = result.film_weight;

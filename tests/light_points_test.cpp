@@ -94,7 +94,7 @@ TEST_CASE("a tile without data or with non-finite sums keeps one point", "[light
   // The choice over the whole image gives such tiles one point (their tiles' data are left out of lambda).
   std::vector<double> stats = tile_stats(0.2, 0.8, 1, 1);
   std::vector<uint8_t> points;
-  choose_tile_points(stats, 100, 1, points);
+  choose_tile_points(stats, 100, 1, 1, points);
   CHECK(int(points[0]) == 1);
 }
 
@@ -124,25 +124,29 @@ TEST_CASE("tiles share one sample count: points go where the image's error is", 
   stats.insert(stats.end(), quiet.begin(), quiet.end());
   std::vector<uint8_t> points;
   for (int spp = 0; spp < point_explore_spp; spp++) {
-    choose_tile_points(stats, spp, spp, points);
+    choose_tile_points(stats, spp, spp, 1, points);
     REQUIRE(points.size() == 2);
     CHECK(int(points[0]) == point_explore_points);
     CHECK(int(points[1]) == point_explore_points);
   }
   // (Passes 9 and 10: tile 1 is not the tile of a re-exploring pass in either.)
   for (int pass : {9, 10}) {
-    choose_tile_points(stats, 100, pass, points);
+    choose_tile_points(stats, 100, pass, 1, points);
     INFO("pass " << pass);
     CHECK(int(points[0]) >= 5);
     CHECK(int(points[1]) == 1);
   }
-  // A tile at one point takes two on one pass in point_explore_passes, by tile and pass.
-  choose_tile_points(stats, 100, int(point_reexplore_passes) - 1, points);
+  // A tile at one point takes two on one pass in point_reexplore_passes, by tile and pass.
+  choose_tile_points(stats, 100, int(point_reexplore_passes) - 1, 1, points);
   CHECK(int(points[1]) == 2);
   // Alike tiles of equal error and share: both 5 (alone or together).
   std::vector<double> twins = quiet;
   twins.insert(twins.end(), quiet.begin(), quiet.end());
-  choose_tile_points(twins, 100, 10, points);
+  choose_tile_points(twins, 100, 10, 1, points);
   CHECK(int(points[0]) == 5);
   CHECK(int(points[1]) == 5);
+  // With 4 draws per vertex each extra point is paid 4 times: (4 + 4 (K - 1)) (0.15 + 0.85 / K) is least at K = 1.
+  choose_tile_points(twins, 100, 10, 4, points);
+  CHECK(int(points[0]) == 1);
+  CHECK(int(points[1]) == 1);
 }
