@@ -655,9 +655,8 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   result.film_weight = r.value<double>();
   // --light-points auto: the tiles' sums (empty before its first pass), every one finite and not negative.
   result.point_stats = r.column<double>();
-  const size_t point_stats_size =
-      size_t(point_tile_cols(w)) * size_t(point_tile_rows(hgt)) * size_t(point_stat_fields);
-  if (!(result.point_stats.empty() || (params.light_points == 0 && result.point_stats.size() == point_stats_size)))
+  if (!(result.point_stats.empty() ||
+        (params.light_points == 0 && result.point_stats.size() == point_stats_size(w, hgt))))
     r.fail("light point statistics");
   for (double x : result.point_stats)
     if (!(std::isfinite(x) && x >= 0)) r.fail("light point statistics");

@@ -175,9 +175,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
   bool prev_mis = false;           // the current ray was BSDF-sampled at a vertex that also ran weighted NEE
   float prev_bsdf_pdf = 0;
   float prev_nee_points = 1;       // ... whose NEE drew this many light points (draws times points per draw)
-  const int points1 = in.point_tiles ? int(in.point_tiles[size_t(y / point_tile_size) * size_t(in.point_tile_cols) +
-                                                          size_t(x / point_tile_size)])
-                                     : in.light_points;
+  const int points1 = in.point_tiles ? int(in.point_tiles[point_tile_of(x, y, in.point_tile_cols)]) : in.light_points;
   if (info) *info = sample_info{0, points1};
   int from_tri = invalid_id;       // a continuation ray: the triangle it leaves, and its normal (org is its point)
   vec3f from_ng;

@@ -66,6 +66,13 @@ int best_points(double within, double rest, double lambda);
 // The tile counts of an image.
 inline int point_tile_cols(int width) { return (width + point_tile_size - 1) / point_tile_size; }
 inline int point_tile_rows(int height) { return (height + point_tile_size - 1) / point_tile_size; }
+// The tile of pixel (x, y) in an image of `cols` tiles to a row, and the length of an image's statistics.
+inline size_t point_tile_of(int x, int y, int cols) {
+  return size_t(y / point_tile_size) * size_t(cols) + size_t(x / point_tile_size);
+}
+inline size_t point_stats_size(int width, int height) {
+  return size_t(point_tile_cols(width)) * size_t(point_tile_rows(height)) * point_stat_fields;
+}
 
 // Every tile's count for the next pass (pass `pass`, `spp` samples per pixel done, `draws` NEE draws per first vertex,
 // each paying K - 1 extra points): point_explore_points before

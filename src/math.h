@@ -72,6 +72,8 @@ inline bool is_finite(vec3f a) { return std::isfinite(a.x) && std::isfinite(a.y)
 inline bool is_black(vec3f a) { return a.x == 0 && a.y == 0 && a.z == 0; }
 // Rec. 709 luminance of linear RGB.
 inline float luminance(vec3f c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+// The same weights in double (statistics summed over many samples).
+inline double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; }
 inline float clampf(float v, float lo, float hi) { return std::min(std::max(v, lo), hi); }
 inline float sqr(float v) { return v * v; }
 // sqrt that treats tiny negative round-off as zero.

@@ -173,7 +173,7 @@ constexpr int rows_per_band() {
 
 // --light-points auto (light_points.h): what a pass gathers for the choice of point counts. The film before the
 // pass gives each pixel's mean; each image row sums its pixels' statistics, in pixel order, into its own slots (one
-// per tile of the row), which end_point_pass folds in row order.
+// per tile of the row), which render_with folds in row order after the pass.
 struct point_gather {
   const std::vector<double>* film = nullptr;
   double film_weight = 0;
@@ -231,7 +231,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                 double m = 0, g = 0, mean_noise = 1;
                 if (has_mean) {
                   const double* f = &(*points->film)[3 * (size_t(y) * w + x)];
-                  m = (0.2126 * f[0] + 0.7152 * f[1] + 0.0722 * f[2]) / points->film_weight;
+                  m = luminance(f[0], f[1], f[2]) / points->film_weight;
                   // (A mean of n earlier samples adds V / n to E (y - m)^2: n / (n + 1) takes it out.)
                   g = 1.0 / (m * m + 0.01);
                   mean_noise = points->mean_samples / (points->mean_samples + 1);
@@ -245,7 +245,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                   slot[ps_samples] += 1;
                   slot[ps_vertices] += double(st.camera_rays + st.bounce_rays - vertices);
                   if (has_mean) {
-                    const double d = 0.2126 * l.x + 0.7152 * l.y + 0.0722 * l.z - m;
+                    const double d = luminance(l.x, l.y, l.z) - m;
                     slot[ps_mean_samples] += 1;
                     slot[ps_sq_dev] += g * mean_noise * d * d;
                     slot[ps_inv_points] += 1.0 / info.points;
@@ -321,11 +321,10 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   // --light-points auto: the tiles' statistics (kept with the film), this pass's rows of them, the tiles' counts.
   const bool auto_points = params.light_points == 0;
   const int tile_cols = point_tile_cols(w);
-  const size_t point_stats_size = size_t(tile_cols) * size_t(point_tile_rows(h)) * point_stat_fields;
   point_gather gather;
   std::vector<uint8_t> tile_points;
   if (auto_points) {
-    if (result.point_stats.size() != point_stats_size) result.point_stats.assign(point_stats_size, 0.0);
+    if (result.point_stats.size() != point_stats_size(w, h)) result.point_stats.assign(point_stats_size(w, h), 0.0);
     gather.rows.assign(size_t(h) * size_t(tile_cols) * point_stat_fields, 0.0);
     gather.cols = tile_cols;
     gather.film = &result.film;
@@ -457,8 +456,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
       for (double& x : result.point_stats) x *= point_stats_decay;
       for (int y = 0; y < h; y++)
         for (int tx = 0; tx < tile_cols; tx++) {
-          double* to = &result.point_stats[(size_t(y / point_tile_size) * size_t(tile_cols) + size_t(tx)) *
-                                           point_stat_fields];
+          double* to = &result.point_stats[point_tile_of(tx * point_tile_size, y, tile_cols) * point_stat_fields];
           const double* from = &gather.rows[(size_t(y) * size_t(tile_cols) + size_t(tx)) * point_stat_fields];
           for (int f = 0; f < point_stat_fields; f++) to[f] += from[f];
         }
