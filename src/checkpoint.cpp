@@ -27,7 +27,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 14: hits on huge triangles take the ray's point, a thin scene's cells its own shortest extent; 15: map_d's
 // -imfchan and an RGB mask's luminance, cells of at least 4 ulps; 16: the fingerprint's parts
 // 17: the first vertex's BSDF direction in the render's stratified set
-constexpr uint32_t version = 18;  // 18: the tiles' statistics of --light-points auto
+// 18: the tiles' statistics of --light-points auto
+constexpr uint32_t version = 19;  // 19: bayes's staged pass weights (the first passes' film where learning paid)
 
 }  // namespace
 
@@ -553,6 +554,11 @@ static void emit_checkpoint(writer& w, const render_fingerprint_data& fingerprin
   }
   w.column(result.film);
   w.value(result.film_weight);
+  w.value(uint8_t(result.late_learns));
+  if (result.late_learns) {
+    w.column(result.early_film);
+    w.value(result.early_weight), w.value(result.late_ref_weight);
+  }
   w.column(result.point_stats);
   write_sampler(w, sampler);
 }
@@ -653,6 +659,11 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   }
   result.film = r.column<double>(size_t(w) * size_t(hgt) * 3);
   result.film_weight = r.value<double>();
+  result.late_learns = r.value<uint8_t>() != 0;
+  if (result.late_learns) {
+    result.early_film = r.column<double>(size_t(w) * size_t(hgt) * 3);
+    result.early_weight = r.value<double>(), result.late_ref_weight = r.value<double>();
+  }
   // --light-points auto: the tiles' sums (empty before its first pass), every one finite and not negative.
   result.point_stats = r.column<double>();
   if (!(result.point_stats.empty() ||
@@ -680,13 +691,23 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   // The film's weight is a function of the passes (their spp and the weighting fixed in advance): the same sum, in
   // the same order, as the render's.
   const double weighting = sampler_adapts(sampler) ? params.pass_weighting : 0.0;
-  double weight = 0;
+  // bayes's staged weights: its first staged_spp spp, then the later passes' (their own, and their plain ones where
+  // the first passes were kept apart), summed as the render sums them.
+  const bool staged = std::holds_alternative<bayes_sampler>(sampler) && weighting > 0;
+  if (result.late_learns && !(staged && result.spp >= staged_spp)) r.fail("staged pass weights");
+  double weight = 0, early = 0, late_ref = 0;
   spp = 0;
   for (const pass_record& p : result.log) {
-    weight += pass_weight(spp, weighting) * (p.spp - spp);
+    const double wk = staged ? staged_pass_weight(spp, weighting, result.late_learns) : pass_weight(spp, weighting);
+    weight += wk * (p.spp - spp);
+    if (result.late_learns && spp < staged_spp) early = weight;
+    if (result.late_learns && spp >= staged_spp) late_ref += pass_weight(spp, weighting) * (p.spp - spp);
     spp = p.spp;
   }
   if (result.film_weight != weight) r.fail("film weight");
+  if (result.early_weight != early || result.late_ref_weight != late_ref) r.fail("staged pass weights");
+  for (double x : result.early_film)
+    if (!std::isfinite(float(x / early))) r.fail("film");
   // Every sample is a finite float, so every pixel's mean converts to a finite float as the image does it (film_image);
   // a value finite in double but beyond that (an edit) was written as an infinite pixel. Without a pass (an
   // animation's frame stopped before its first) the film is empty: all zeros.

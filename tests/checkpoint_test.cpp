@@ -393,6 +393,10 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   f.log = c.value(log * pass_record_bytes);
   f.film = c.column(8);
   f.film_weight = c.value(8);
+  if (c.get<uint8_t>(c.value(1)) != 0) {  // bayes's staged weights: the first passes' film, its weight, the later ones'
+    c.column(8);
+    c.value(8 + 8);
+  }
   f.point_stats = c.column(8);  // (--light-points auto's; empty otherwise)
   f.regions = c.pos;
   for (int k = 0; k < 5; k++) c.column(k == 0 ? 8 : 4);  // key, cut_offset, cut_size, pair_offset, parent

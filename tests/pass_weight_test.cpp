@@ -60,6 +60,94 @@ TEST_CASE("pass weights start below one and approach it", "[passes]") {
   for (int n = 0; n < 100; n++) CHECK(pass_weight(n + 1, 4) > pass_weight(n, 4));
 }
 
+TEST_CASE("bayes's first 8 spp weigh less, and its later passes less again where learning paid", "[passes]") {
+  for (int n = 0; n < staged_spp; n++) CHECK(staged_pass_weight(n, 4, true) == pass_weight(n, 16));
+  for (int n = 0; n < staged_spp; n++) CHECK(staged_pass_weight(n, 4, false) == pass_weight(n, 16));
+  for (int n : {8, 20, 400}) {
+    CHECK(staged_pass_weight(n, 4, false) == pass_weight(n, 4));
+    CHECK(staged_pass_weight(n, 4, true) == pass_weight(n, 64));
+  }
+  for (int n : {0, 7, 8, 100}) CHECK(staged_pass_weight(n, 0, true) == 1.0);
+}
+
+TEST_CASE("an image of staged passes is the first passes' mean and the later ones' in fixed shares", "[passes]") {
+  // One pixel: first passes of weight 2 summing (2, 4, 6), later ones of weight 3 among themselves summing (9, 3, 0),
+  // whose plain weight is 6: shares 2 / 8 and 6 / 8.
+  render_result r;
+  r.width = r.height = 1;
+  r.spp = 20;
+  r.early_film = {2, 4, 6};
+  r.early_weight = 2;
+  r.film = {2 + 9, 4 + 3, 6 + 0};
+  r.film_weight = 2 + 3;
+  r.late_ref_weight = 6;
+  r.late_learns = true;
+  image_data img = film_image(r);
+  CHECK(img.pixels[0] == Approx(0.25 * 1 + 0.75 * 3));
+  CHECK(img.pixels[1] == Approx(0.25 * 2 + 0.75 * 1));
+  CHECK(img.pixels[2] == Approx(0.25 * 3 + 0.75 * 0));
+  // Without the first passes kept apart, the film's weighted mean.
+  r.early_film.clear();
+  r.late_learns = false;
+  img = film_image(r);
+  CHECK(img.pixels[0] == Approx(11.0 / 5));
+}
+
+TEST_CASE("where bayes's check finds learning to pay by 8 spp, its later direct passes weigh apart", "[passes]") {
+  // 256 x 256 pixels: the first check window (spp 4-7, 262144 samples) completes by 8 spp and finds learning paying
+  // by far (the bound prior sends most samples to the shut-in lamp). The first 8 spp's film is a render of 8 spp's,
+  // bit for bit; the later passes' sums (from unweighted renders stopped at each pass, which sample and learn the
+  // same) weigh pass_weight(n, 64) among themselves; their share is that of pass_weight(n, 4).
+  auto b = boxed_lamp_scene();
+  auto params = [](int spp, double weighting) {
+    render_params p = small_params(sampler_kind::bayes, spp, weighting);
+    p.width = p.height = 256;
+    return p;
+  };
+  render_result r8 = render(b->scene, b->bvh, b->lights, params(8, 4));
+  REQUIRE(r8.late_learns);
+  CHECK(r8.early_film == r8.film);
+  render_result r15 = render(b->scene, b->bvh, b->lights, params(15, 4));
+  REQUIRE(r15.late_learns);
+  CHECK(r15.early_film == r8.film);
+  CHECK(r15.early_weight == r8.film_weight);
+  const int ends[] = {8, 10, 12, 15};
+  std::vector<std::vector<double>> cumulative;
+  for (int e : ends) cumulative.push_back(render(b->scene, b->bvh, b->lights, params(e, 0)).film);
+  std::vector<double> late(r15.film.size(), 0.0);
+  double late_weight = 0, late_ref = 0;
+  for (size_t k = 1; k < cumulative.size(); k++) {
+    const int before = ends[k - 1], count = ends[k] - before;
+    late_weight += pass_weight(before, 64) * count;
+    late_ref += pass_weight(before, 4) * count;
+    for (size_t i = 0; i < late.size(); i++) late[i] += pass_weight(before, 64) * (cumulative[k][i] - cumulative[k - 1][i]);
+  }
+  CHECK(r15.late_ref_weight == Approx(late_ref).epsilon(1e-12));
+  const double share = r8.film_weight / (r8.film_weight + late_ref);
+  image_data img = film_image(r15);
+  double worst = 0, scale = 0;
+  for (size_t i = 0; i < late.size(); i++) {
+    const double expect = share * r8.film[i] / r8.film_weight + (1 - share) * late[i] / late_weight;
+    worst = std::max(worst, std::fabs(img.pixels[i] - expect));
+    scale = std::max(scale, std::fabs(expect));
+  }
+  REQUIRE(scale > 0);
+  CHECK(worst <= 1e-6 * scale);
+  // Two threads or one: the same film and the same first passes.
+  render_params one = params(15, 4);
+  one.threads = 1;
+  render_result r1 = render(b->scene, b->bvh, b->lights, one);
+  CHECK(r1.film == r15.film);
+  CHECK(r1.early_film == r15.early_film);
+  // Path traced, the later passes keep the plain weights (the bounces' noise, which learning leaves, dominates them).
+  render_params path = params(9, 4);
+  path.max_depth = 2;
+  render_result rp = render(b->scene, b->bvh, b->lights, path);
+  CHECK_FALSE(rp.late_learns);
+  CHECK(rp.early_film.empty());
+  CHECK(rp.film_weight == Approx(r8.film_weight + pass_weight(8, 4)).epsilon(1e-12));
+}
+
 TEST_CASE("an adaptive sampler's film is each pass's sums times the pass's fixed weight", "[passes]") {
   auto b = boxed_lamp_scene();
   for (sampler_kind kind : {sampler_kind::bayes, sampler_kind::donikian}) {
@@ -75,12 +163,13 @@ TEST_CASE("an adaptive sampler's film is each pass's sums times the pass's fixed
     }
     render_result w = render(b->scene, b->bvh, b->lights, small_params(kind, 15, 4));
     REQUIRE(w.spp == 15);
+    CHECK_FALSE(w.late_learns);  // (144 pixels: bayes's first check window is far from complete at 8 spp)
     REQUIRE(w.passes == 11);
     double weight = 0;
     std::vector<double> expect(w.film.size(), 0.0);
     int before = 0;
     for (size_t k = 0; k < cumulative.size(); k++) {
-      double wk = pass_weight(before, 4);
+      double wk = kind == sampler_kind::bayes ? staged_pass_weight(before, 4, false) : pass_weight(before, 4);
       weight += wk * (ends[k] - before);
       for (size_t i = 0; i < expect.size(); i++)
         expect[i] += wk * (cumulative[k][i] - (k > 0 ? cumulative[k - 1][i] : 0.0));
