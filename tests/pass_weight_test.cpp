@@ -388,3 +388,37 @@ TEST_CASE("a cut pass continued in pieces is the image of one pass of its sample
     CHECK(s.film == r.film);
   }
 }
+
+TEST_CASE("staged weights keep bayes's image unbiased", "[passes]") {
+  // The boxed lamp at 256 x 256, 12 spp: bayes's later passes weigh apart from its first 8 spp (late_learns) and its
+  // image is the two groups' means in fixed shares. Over 12 seeds the image mean of bayes minus that of uniform (other
+  // seeds) must lie within 4 standard errors of 0 (two-sided, 99.99 %); a share or a normalisation gone wrong (the
+  // first group's share counted twice, say) moves it by many. (A standard error of about 1e-4 of the image's level:
+  // a bias of 0.05 % would show.)
+  auto b = boxed_lamp_scene();
+  auto image_mean = [&](sampler_kind kind, uint64_t seed, bool& staged) {
+    render_params p = small_params(kind, 12, 4, seed);
+    p.width = p.height = 256;
+    render_result r = render(b->scene, b->bvh, b->lights, p);
+    staged = r.late_learns;
+    image_data img = film_image(r);
+    double sum = 0;
+    for (float v : img.pixels) sum += v;
+    return sum / double(img.pixels.size());
+  };
+  std::vector<double> diff;
+  double level = 0;
+  for (uint64_t seed = 1; seed <= 12; seed++) {
+    bool staged = false, plain = false;
+    const double m_bayes = image_mean(sampler_kind::bayes, seed, staged);
+    const double m_uniform = image_mean(sampler_kind::uniform, 1000 + seed, plain);
+    REQUIRE(staged);
+    diff.push_back(m_bayes - m_uniform);
+    level += m_uniform / 12;
+  }
+  mean_se m = mean_and_se(diff);
+  INFO("bayes - uniform: " << m.mean << " +- " << m.se << " at a level of " << level);
+  REQUIRE(m.se > 0);
+  CHECK(std::fabs(m.mean) < 4 * m.se);
+  CHECK(m.se < 2e-4 * level);
+}
