@@ -693,7 +693,7 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   const double weighting = sampler_adapts(sampler) ? params.pass_weighting : 0.0;
   // bayes's staged weights: its first staged_spp spp, then the later passes' (their own, and their plain ones where
   // the first passes were kept apart), summed as the render sums them.
-  const bool staged = std::holds_alternative<bayes_sampler>(sampler) && weighting > 0;
+  const bool staged = std::holds_alternative<bayes_sampler>(sampler) && stages_passes(params, weighting);
   if (result.late_learns && !(staged && result.spp >= staged_spp)) r.fail("staged pass weights");
   double weight = 0, early = 0, late_ref = 0;
   spp = 0;

@@ -316,7 +316,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     result.spp = result.passes = 0;
   }
   const double weighting = adapts(sampler) ? params.pass_weighting : 0.0;
-  const bool staged = std::is_same_v<Sampler, bayes_sampler> && weighting > 0;  // (staged_pass_weight)
+  const bool staged = std::is_same_v<Sampler, bayes_sampler> && stages_passes(params, weighting);
   if constexpr (std::is_same_v<Sampler, bayes_sampler>) {
     // The fallback check starts afresh with each frame (its first pass is not checked).
     if (result.spp == 0) sampler.restart_check();
@@ -475,11 +475,9 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
       bool was = sampler.fallback;
       sampler.check_fallback(rows.records, result.film, result.film_weight, count, done + count);
       changed = sampler.fallback != was;
-      // The end of the first staged_spp spp: where the check has found learning to pay, the later passes of a direct
-      // render weigh by the learner's schedule among themselves, and the passes so far keep their share
-      // (staged_pass_weight).
-      if (staged && params.max_depth == 1 && done < staged_spp && done + count >= staged_spp && sampler.check_done &&
-          !sampler.fallback) {
+      // The end of the first staged_spp spp: where the check has found learning to pay, the later passes weigh by the
+      // learner's schedule among themselves, and the passes so far keep their share (staged_pass_weight).
+      if (staged && done < staged_spp && done + count >= staged_spp && sampler.check_done && !sampler.fallback) {
         result.early_film = result.film;
         result.early_weight = result.film_weight;
         result.late_learns = true;
@@ -570,17 +568,22 @@ double pass_weight(int done, double s) {
   return (done + 1.0) / (done + 1.0 + s);
 }
 
+bool stages_passes(const render_params& params, double weighting) {
+  return weighting > 0 && params.max_depth == 1;
+}
+
 double staged_pass_weight(int done, double s, bool late_learns) {
   // bayes's first passes are sampled from the prior (the bound sampler's choice) or from a model of a few samples:
   // in the living room (direct, 320 x 240) the first pass has several hundred times the per-sample relMSE of a
-  // learned one, and passes up to about 32 spp still weigh on the image. Those first 8 spp weigh pass_weight(n, 4s);
-  // in a direct render whose fallback check has found learning to pay by their end, the later passes weigh
-  // pass_weight(n, 16s) among themselves, their share of the image still the plain schedule's (film_image), so that
-  // no weight or share depends on the samples it weighs: the image stays unbiased. Elsewhere (bayes fell back, its
-  // check has not decided, or the render is path traced: the bounces' noise, which learning leaves, dominates the
-  // later passes, and the living room at 128 spp lost 1.06-1.10x) the later passes weigh pass_weight(n, s), as
-  // before. Measured at 400 spp, seeds 11 / 12, in the living room, direct: relMSE 5.70 / 5.84e-5 with
-  // pass_weight(n, s) throughout, 3.78 / 3.90e-5 staged.
+  // learned one, and passes up to about 32 spp still weigh on the image. In a direct render (stages_passes) those
+  // first 8 spp weigh pass_weight(n, 4s); where the fallback check has found learning to pay by their end, the later
+  // passes weigh pass_weight(n, 16s) among themselves, their share of the image still the plain schedule's
+  // (film_image), so that no weight or share depends on the samples it weighs: the image stays unbiased. Elsewhere
+  // (bayes fell back or its check has not decided) the later passes weigh pass_weight(n, s), as before. Measured at
+  // 400 spp, seeds 11 / 12, in the living room, direct: relMSE 5.70 / 5.84e-5 with pass_weight(n, s) throughout,
+  // 3.78 / 3.90e-5 staged. Path traced, the bounces' noise, which learning leaves, is most of a learned pass's
+  // variance and the passes differ less: staged later passes lost 1.06-1.10x in the living room (128 spp), the staged
+  // first 8 spp alone 1.025x in the plant room (116 spp), so path-traced renders keep pass_weight(n, s) throughout.
   if (done < staged_spp) return pass_weight(done, staged_early * s);
   return pass_weight(done, late_learns ? staged_late * s : s);
 }

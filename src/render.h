@@ -76,8 +76,8 @@ struct render_result {
   int frame = 0;              // the animation frame (render_frames; a checkpoint of frame k resumes there)
   std::vector<double> film;   // per pixel RGB sums over all completed samples, each pass's times its weight
   double film_weight = 0;     // the sum of the weights of one pixel's samples (= spp when all weigh 1)
-  // bayes's staged pass weights (staged_pass_weight): where (direct illumination) its fallback check had found
-  // learning to pay by the end of its first staged_spp spp, the film's sums of those passes (F_e) and their weight W_e, kept apart; the later
+  // bayes's staged pass weights (staged_pass_weight, direct renders): where its fallback check had found learning to
+  // pay by the end of its first staged_spp spp, the film's sums of those passes (F_e) and their weight W_e, kept apart; the later
   // passes' share of the image is that of the plain schedule, late_ref_weight their weight under it (film_image).
   // Empty, 0 and false otherwise: the film alone is the image's sums.
   std::vector<double> early_film;
@@ -120,13 +120,14 @@ bool ends_scheduled_pass(int spp, int64_t pixels);
 int fit_pass_to_time(int count, double left, double seconds_per_spp);
 // Weight of the samples of a pass that starts after `done` spp: (done + 1) / (done + 1 + s), 1 for s = 0.
 double pass_weight(int done, double s);
-// bayes's passes (s > 0): its first staged_spp spp weigh pass_weight(done, staged_early * s); the later ones
-// pass_weight(done, s), or pass_weight(done, staged_late * s) among themselves where `late_learns` (direct
-// illumination, and its fallback check found learning to pay within those first spp), their share of the image then
-// still that of pass_weight(done, s) (render_result::early_film). Every weight and share is fixed before the pass's
-// samples are drawn.
+// bayes's passes in a direct render (stages_passes: s > 0, max_depth 1): its first staged_spp spp weigh
+// pass_weight(done, staged_early * s); the later ones pass_weight(done, s), or pass_weight(done, staged_late * s)
+// among themselves where `late_learns` (its fallback check found learning to pay within those first spp), their share
+// of the image then still that of pass_weight(done, s) (render_result::early_film). Every weight and share is fixed
+// before the pass's samples are drawn. Path-traced renders weigh pass_weight(done, s) throughout.
 constexpr int staged_spp = 8;
 constexpr double staged_early = 4, staged_late = 16;
+bool stages_passes(const render_params& params, double weighting);
 double staged_pass_weight(int done, double s, bool late_learns);
 // Whether the sampler's passes are weighted by pass_weight (an adaptive sampler that still learns).
 bool sampler_adapts(const light_sampler& s);
