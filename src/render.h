@@ -77,9 +77,9 @@ struct render_result {
   std::vector<double> film;   // per pixel RGB sums over all completed samples, each pass's times its weight
   double film_weight = 0;     // the sum of the weights of one pixel's samples (= spp when all weigh 1)
   // bayes's staged pass weights (staged_pass_weight, direct renders): where its fallback check had found learning to
-  // pay by the end of its first staged_spp spp, the film's sums of those passes (F_e) and their weight W_e, kept apart; the later
-  // passes' share of the image is that of the plain schedule, late_ref_weight their weight under it (film_image).
-  // Empty, 0 and false otherwise: the film alone is the image's sums.
+  // pay by the end of its first staged_spp spp, the film's sums of those passes (F_e) and their weight W_e, kept
+  // apart; the later passes' share of the image is that of the plain schedule, late_ref_weight their weight under it
+  // (film_image). Empty, 0 and false otherwise: the film alone is the image's sums.
   std::vector<double> early_film;
   double early_weight = 0;
   double late_ref_weight = 0;

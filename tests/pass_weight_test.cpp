@@ -120,7 +120,8 @@ TEST_CASE("where bayes's check finds learning to pay by 8 spp, its later direct 
     const int before = ends[k - 1], count = ends[k] - before;
     late_weight += pass_weight(before, 64) * count;
     late_ref += pass_weight(before, 4) * count;
-    for (size_t i = 0; i < late.size(); i++) late[i] += pass_weight(before, 64) * (cumulative[k][i] - cumulative[k - 1][i]);
+    for (size_t i = 0; i < late.size(); i++)
+      late[i] += pass_weight(before, 64) * (cumulative[k][i] - cumulative[k - 1][i]);
   }
   CHECK(r15.late_ref_weight == Approx(late_ref).epsilon(1e-12));
   const double share = r8.film_weight / (r8.film_weight + late_ref);
