@@ -1,5 +1,5 @@
 # shellcheck shell=bash
-# Sourced by the bench scripts that cache references (eqtable.sh, eqtime.sh, flicker.sh).
+# Sourced by the bench scripts that cache references (eqtable.sh, eqtime.sh, flicker.sh, gridstudy.sh).
 # ref_key DIR GLOB [WORDS...]: 12 hex digits of a hash over the scene files under DIR (its .json, .obj, .mtl and
 # texture images, by their names relative to DIR, three levels deep; not renders or a reference cache kept there),
 # the golden images matching golden/GLOB and the WORDS (size, spp, options). A reference cached under this key is rendered again when the scene changes or when the renderer changes
