@@ -35,7 +35,8 @@ struct bayes_params {
                                  // so a shading point only scales each pair's posterior weight by 1 / d^2 (the
                                  // regression) and drops clusters behind its surface; false (ablation): mu0 from the
                                  // bound at every shading point, which then evaluates full cone bounds per cluster
-  double cv_min_visible = 0.98;  // control variates only for pairs with E[1 - p0] at least this
+  double cv_min_visible = 0.96;  // control variates only for pairs with E[1 - p0] at least this (README: 0.94 and
+                                 // below gave the living room fireflies in dark pixels next to the sun's shadow edges)
   double refold_tolerance = 0.05;  // hierarchy: a coarse pair's children are refolded when its p1 has moved by more
                                    // than this fraction (of max(p1, 0.1)) since their last fold (a child's p1 moves
                                    // by at most that fraction too); 0: whenever it changes at all

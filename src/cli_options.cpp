@@ -122,7 +122,7 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_flag_callback("--bayes-no-cv", [&o] { o.bayes.control_variate = false; },
                        "Ablation: no control variates (with the region prior they apply where NEE is unweighted)")->group(bg);
   r->add_option("--bayes-cv-min-visible", o.bayes.cv_min_visible,
-                "Control variates only for clusters a region sees with probability at least this (default 0.98) "
+                "Control variates only for clusters a region sees with probability at least this (default 0.96) "
                 "and that have samples there or in its coarse region (their mean is capped by those samples' mean)")
       ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
   r->add_flag_callback("--bayes-no-orientation", [&o] { o.bayes.orientation = false; },
