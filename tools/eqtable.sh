@@ -33,14 +33,7 @@ for scene in $SCENES; do
     spp=$REF_SPP_DIRECT; [ "$mode" = path ] && spp=$REF_SPP_PATH
     key=$(ref_key "data/$scene" "${scene}_${mode}_*")
     ref=$refdir/${scene}_${mode}_${W}x${H}_${REF_SAMPLER}_${spp}_${key}.exr
-    if [ ! -f "$ref" ]; then
-      echo "reference $ref ($REF_SAMPLER, $spp spp)" >&2
-      # Under a temporary name until it completes: an interrupted render writes the image of its passes so far, which
-      # must not be taken for the reference by the next run.
-      "$bin" render "$json" --sampler "$REF_SAMPLER" --spp "$spp" --seed 987654321 --width "$W" --height "$H" \
-        -o "$ref.part.exr" --quiet
-      mv "$ref.part.exr" "$ref"
-    fi
+    ensure_reference "$bin" "$json" "$REF_SAMPLER" "$spp" "$W" "$H" "$ref"
     row="| $scene | $mode |"
     declare -A err=()
     for s in $SAMPLERS; do

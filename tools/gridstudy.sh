@@ -16,13 +16,9 @@ grids=${GRIDS:-"8 16 32 64 128 256"}
 json=data/$scene/direct.json
 refdir=$(dirname "$bin")/ref; mkdir -p "$refdir"
 # The reference eqtable.sh caches for the same scene, size and spp (keyed by ref_key: rendered again when the scene or
-# the renderer's images change, never a stale one), written under a temporary name until it completes.
+# the renderer's images change, never a stale one).
 ref=$refdir/${scene}_direct_${W}x${H}_bayes_${REF_SPP_DIRECT}_$(ref_key "data/$scene" "${scene}_direct_*").exr
-if [ ! -f "$ref" ]; then
-  "$bin" render "$json" --sampler bayes --spp "$REF_SPP_DIRECT" --seed 987654321 --width "$W" --height "$H" \
-    -o "$ref.part.exr" --quiet
-  mv "$ref.part.exr" "$ref"
-fi
+ensure_reference "$bin" "$json" bayes "$REF_SPP_DIRECT" "$W" "$H" "$ref"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 err() {  # mean relMSE over the seeds of one configuration
   local sum=0 n=0
