@@ -14,13 +14,8 @@ name=$(basename "$(dirname "$scene")"); glob='*'
 [ "$(cd "$(dirname "$scene")" 2>/dev/null && pwd)" = "$ref_key_root/data/$name" ] && glob="${name}_*"
 key=$(ref_key "$(dirname "$scene")" "$glob" "$(basename "$scene") $W $H $REF_SPP $REF_SAMPLER $extra")
 ref="$dir/$(basename "$(dirname "$scene")")_$(basename "$scene" .json)_$key.exr"
-if [ ! -f "$ref" ]; then
-  echo "reference: $REF_SAMPLER $REF_SPP spp -> $ref" >&2
-  # (under a temporary name until complete: an interrupted render writes its partial image)
-  "$bin" render "$scene" --sampler "$REF_SAMPLER" --spp "$REF_SPP" --seed 987654321 --width "$W" --height "$H" $extra \
-    -o "$ref.part.exr" --quiet
-  mv "$ref.part.exr" "$ref"
-fi
+# shellcheck disable=SC2086  # $extra: words on purpose
+ensure_reference "$bin" "$scene" "$REF_SAMPLER" "$REF_SPP" "$W" "$H" "$ref" $extra
 tmp=$(mktemp -d)
 for s in $samplers; do
   "$bin" render "$scene" --sampler "$s" --time "$secs" --width "$W" --height "$H" $extra --reference "$ref" \

@@ -14,14 +14,16 @@ ref_key() {
     (cd "$ref_key_root" && find golden -name "$glob" -type f -print0 | sort -z | xargs -0 -r sha256sum)
     echo "$*"; } | sha256sum | cut -c1-12
 }
-# ensure_reference BIN JSON SAMPLER SPP W H PATH: renders the reference PATH (seed 987654321, independent of the
-# measured renders' seeds) unless it is cached, under a temporary name until it completes: an interrupted render
-# writes the image of its passes so far, which must not be taken for the reference by the next run.
+# ensure_reference BIN JSON SAMPLER SPP W H PATH [OPTIONS...]: renders the reference PATH (seed 987654321,
+# independent of the measured renders' seeds; OPTIONS added to the render) unless it is cached, under a temporary name
+# until it completes: an interrupted render writes the image of its passes so far, which must not be taken for the
+# reference by the next run.
 ensure_reference() {
   local bin=$1 json=$2 sampler=$3 spp=$4 w=$5 h=$6 path=$7
+  shift 7
   [ -f "$path" ] && return 0
   echo "reference $path ($sampler, $spp spp)" >&2
-  "$bin" render "$json" --sampler "$sampler" --spp "$spp" --seed 987654321 --width "$w" --height "$h" \
+  "$bin" render "$json" --sampler "$sampler" --spp "$spp" --seed 987654321 --width "$w" --height "$h" "$@" \
     -o "$path.part.exr" --quiet
   mv "$path.part.exr" "$path"
 }
