@@ -565,7 +565,8 @@ void bayes_sampler::begin_frame(double decay) {
 }
 
 void bayes_sampler::refresh_all_weights() {
-  refresh_weights(stats, params.hierarchy > 0 && params.prior ? &regions.pair_parent : nullptr, params);
+  refresh_weights(stats, params.hierarchy > 0 && params.prior ? &regions.pair_parent : nullptr, params,
+                  &regions.pair_node);
   refresh_groups(nullptr);
 }
 
@@ -700,7 +701,7 @@ void bayes_sampler::refold(const std::vector<int>& touched, size_t old_pairs) {
   std::vector<uint8_t>& dirty = stats.scratch.dirty;
   if (regions.members) dirty.resize(stats.m.size(), 0);
   auto fold = [&](size_t i) {
-    fold_weight(stats, i, hier ? regions.pair_parent[i] : invalid_id, params);
+    fold_weight(stats, i, hier ? regions.pair_parent[i] : invalid_id, params, regions.pair_node[i] == sun_cluster);
     if (regions.members) dirty[i] = 1;
   };
   // Children of coarse pairs whose p1 moved by more than the tolerance since their children were last examined. A

@@ -24,7 +24,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   s.cv.resize(n + 4, 0.0f);
   if (n > old) {
     // All empty pairs share the prior-only coefficients (and, without data anywhere, the same weight).
-    fold_weight(s, old, invalid_id, p);
+    fold_weight(s, old, invalid_id, p, false);  // (no samples: no control variate, lamp or sun)
     for (size_t i = old + 1; i < n; i++) {
       if (!p.region_prior) s.weight[i] = s.weight[old];
       s.w[i] = s.w[old];
@@ -97,12 +97,13 @@ void bayes_row::add_at(int index, double z) {
   a.m2 += delta * (z - a.mean);
 }
 
-void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p) {
+void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p,
+                     const std::vector<int>* nodes) {
   // Every pair independently (the result does not depend on how the range is split).
   tbb::parallel_for(tbb::blocked_range<size_t>(0, s.m.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); i++) {
       int up = parents ? (*parents)[i] : invalid_id;
-      fold_weight(s, i, up, p);
+      fold_weight(s, i, up, p, nodes && (*nodes)[i] == sun_cluster);
       if (up < 0) {
         s.p1_folded[i] = own_p1(s, i, p);
         s.k_folded[i] = float(own_posterior_mean(s, i, p));

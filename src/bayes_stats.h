@@ -35,8 +35,10 @@ struct bayes_params {
                                  // so a shading point only scales each pair's posterior weight by 1 / d^2 (the
                                  // regression) and drops clusters behind its surface; false (ablation): mu0 from the
                                  // bound at every shading point, which then evaluates full cone bounds per cluster
-  double cv_min_visible = 0.96;  // control variates only for pairs with E[1 - p0] at least this (README: 0.94 and
-                                 // below gave the living room fireflies in dark pixels next to the sun's shadow edges)
+  double cv_min_visible = 0;      // control variates only for lamp pairs with E[1 - p0] at least this (README: any
+                                 // visibility gained on the data/ scenes: a lamp's shadows are soft)
+  double cv_sun_min_visible = 0.96;  // ... and for the sun's pairs (its shadow edges are sharp: 0.94 and below gave the
+                                     // living room fireflies in dark pixels next to them)
   double refold_tolerance = 0.05;  // hierarchy: a coarse pair's children are refolded when its p1 has moved by more
                                    // than this fraction (of max(p1, 0.1)) since their last fold (a child's p1 moves
                                    // by at most that fraction too); 0: whenever it changes at all
@@ -243,7 +245,8 @@ inline pair_weight folded_coeffs(const bayes_stats& s, size_t i, double p1, cons
 // Folds pair i's p1 (and, under the mean hierarchy, its parent's mean) into its sampling weight.
 template <class H>
 inline double eval_weight(const H& h, const bayes_params& p, double v, double g);
-inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p) {
+// `sun`: the pair is the sun's (its control variate needs cv_sun_min_visible).
+inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p, bool sun) {
   double p1 = pair_p1(s, i, up, p);
   if (up >= 0) s.p1_folded[i] = float(p1);  // a child: the p1 its weight now holds (see bayes_sampler::refold)
   pair_weight pw = folded_coeffs(s, i, p1, p);
@@ -267,9 +270,12 @@ inline void fold_weight(bayes_stats& s, size_t i, int up, const bayes_params& p)
   s.w[i] = float(W);
   if (!p.control_variate) return;
   double k, h;
-  // Only for clusters the region nearly always sees: where visibility is mixed it is usually a function of
-  // position (a shadow edge through the region), and a region-wide mean would add, not remove, variance.
-  bool cv = p.second_moment && p1 >= p.cv_min_visible && pair_posterior(s, i, p, mu0, k, h);
+  // For the sun only where the region nearly always sees it: its shadow edges are sharp, so where its visibility is
+  // mixed the region holds points fully in its shadow, often dark ones, at which c_J / P_J of a mean that large is a
+  // firefly. A lamp's shadows are soft and its mean is one part of a point's light among others: its control
+  // variate paid at any visibility on the data/ scenes (README).
+  bool cv = p.second_moment && p1 >= (sun ? p.cv_sun_min_visible : p.cv_min_visible) &&
+            pair_posterior(s, i, p, mu0, k, h);
   // The control variate's mean of z, cm: the posterior mean k, but never above the mean of the samples themselves
   // (the pair's own, or where it has none its parent's), and none where neither has a sample. A prior mean alone
   // can be far too large (a bound is an upper limit: a lamp facing a ceiling 1 mm away, which the rest of the
@@ -307,9 +313,11 @@ inline bool pair_state_finite(const bayes_stats& s, size_t i) {
   if (i < s.w.size()) ok = ok && std::isfinite(s.w[i]) && std::isfinite(s.w_cv[i]) && std::isfinite(s.cv[i]);
   return ok;
 }
-// Folds every pair's p1 into its weight (parents: region_state::pair_parent, or nullptr for none): the sweep
-// that ends learning between passes.
-void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p);
+// Folds every pair's p1 into its weight (parents: region_state::pair_parent, or nullptr for none; nodes:
+// region_state::pair_node, whose sun_cluster entries mark the sun's pairs, or nullptr for none): the sweep that ends
+// learning between passes.
+void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p,
+                     const std::vector<int>* nodes = nullptr);
 // Weight of a pair for a point with prior mean v (= scale * bound) and g = 1 / d^2; 0 when v is 0.
 template <class H>
 inline double eval_weight(const H& h, const bayes_params& p, double v, double g) {

@@ -28,7 +28,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // -imfchan and an RGB mask's luminance, cells of at least 4 ulps; 16: the fingerprint's parts
 // 17: the first vertex's BSDF direction in the render's stratified set
 // 18: the tiles' statistics of --light-points auto
-constexpr uint32_t version = 19;  // 19: bayes's staged pass weights (the first passes' film where learning paid)
+// 19: bayes's staged pass weights (the first passes' film where learning paid)
+constexpr uint32_t version = 20;  // 20: the sun's control-variate threshold apart from the lamps' (in the fingerprint)
 
 }  // namespace
 
@@ -443,12 +444,13 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
     const bayes_params d;
     if (!b.prior) b.a0 = d.a0, b.b0 = d.b0, b.kappa0 = d.kappa0, b.alpha0 = d.alpha0, b.c = d.c;
     if (!b.region_prior) b.orientation = d.orientation, b.bsdf_factor = d.bsdf_factor, b.control_variate = d.control_variate;
-    if (!b.region_prior || !b.second_moment || !b.control_variate) b.cv_min_visible = d.cv_min_visible;
+    if (!b.region_prior || !b.second_moment || !b.control_variate)
+      b.cv_min_visible = d.cv_min_visible, b.cv_sun_min_visible = d.cv_sun_min_visible;
     if (!b.second_moment) b.control_variate = d.control_variate;
     if (!b.prior || !b.region_prior || !(b.hierarchy > 0)) b.mean_hierarchy = d.mean_hierarchy;
     h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
     h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
-    h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible);
+    h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible), h.value(b.cv_sun_min_visible);
     h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
     h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
   }

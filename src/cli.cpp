@@ -89,11 +89,13 @@ std::string unused_because(const std::string& name, const std::string& group, sa
                   name == "--bayes-alpha0" || name == "--bayes-c" || name == "--bayes-no-mean-hierarchy"))
       return "no prior with --bayes-naive";
     if (point && (name == "--bayes-no-orientation" || name == "--bayes-no-bsdf-factor" || name == "--bayes-no-cv" ||
-                  name == "--bayes-cv-min-visible" || name == "--bayes-no-mean-hierarchy"))
+                  name == "--bayes-cv-min-visible" || name == "--bayes-cv-sun-min-visible" ||
+                  name == "--bayes-no-mean-hierarchy"))
       return "region prior only, not with --bayes-prior point";
-    if (mean && (name == "--bayes-no-cv" || name == "--bayes-cv-min-visible"))
+    const bool cv_threshold = name == "--bayes-cv-min-visible" || name == "--bayes-cv-sun-min-visible";
+    if (mean && (name == "--bayes-no-cv" || cv_threshold))
       return "control variates need --bayes-pmf second-moment";
-    if (!o.bayes.control_variate && name == "--bayes-cv-min-visible") return "no control variates with --bayes-no-cv";
+    if (!o.bayes.control_variate && cv_threshold) return "no control variates with --bayes-no-cv";
     if (!(o.bayes.hierarchy > 0) && name == "--bayes-no-mean-hierarchy") return "no hierarchy with --bayes-hierarchy 0";
     return "";
   }

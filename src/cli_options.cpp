@@ -122,8 +122,13 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_flag_callback("--bayes-no-cv", [&o] { o.bayes.control_variate = false; },
                        "Ablation: no control variates (with the region prior they apply where NEE is unweighted)")->group(bg);
   r->add_option("--bayes-cv-min-visible", o.bayes.cv_min_visible,
-                "Control variates only for clusters a region sees with probability at least this (default 0.96) "
-                "and that have samples there or in its coarse region (their mean is capped by those samples' mean)")
+                "Control variates only for lamp clusters a region sees with probability at least this (default 0: "
+                "any) and that have samples there or in its coarse region (their mean is capped by those samples' "
+                "mean)")
+      ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
+  r->add_option("--bayes-cv-sun-min-visible", o.bayes.cv_sun_min_visible,
+                "The same for the sun (default 0.96: its sharp shadow edges made control variates at lower "
+                "visibility fireflies in the dark pixels beside them)")
       ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
   r->add_flag_callback("--bayes-no-orientation", [&o] { o.bayes.orientation = false; },
                        "Ablation: a point scales a cluster's weight by 1/d^2 only, not also by the receiver cosine bound")

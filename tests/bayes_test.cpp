@@ -170,9 +170,9 @@ shade_point pixel_point(const test_scene& t, int x, int y) {
   return shade_point{sp.p, sp.ng, 0.5f, y * t.in.camera.width + x, 1};
 }
 
-// A bayes sampler over make_scene(3, false) whose cuts are the 3 lamps (3 clusters, not a shared cut of 6 leaves,
-// and not refined into members: each cluster is one pair, whose posterior the tests below follow), with bayes
-// parameters `bp`, and a context prepared at pixel (4, 4) whose cut is those 3 clusters.
+// A bayes sampler over make_scene(3, sun) whose cuts are the 3 lamps (3 clusters, not a shared cut of 6 leaves,
+// and not refined into members: each cluster is one pair, whose posterior the tests below follow), then the sun if
+// `sun`, with bayes parameters `bp`, and a context prepared at pixel (4, 4) whose cut is those clusters.
 struct three_lamps {
   std::unique_ptr<test_scene> t;
   std::optional<light_sampler> ls;
@@ -180,9 +180,9 @@ struct three_lamps {
   std::unique_ptr<cut_context> ctx;
   bayes_sampler& sampler() { return std::get<bayes_sampler>(*ls); }
 };
-three_lamps make_three_lamps(const bayes_params& bp) {
+three_lamps make_three_lamps(const bayes_params& bp, bool sun = false) {
   three_lamps f;
-  f.t = make_scene(3, false);
+  f.t = make_scene(3, sun);
   sampler_params sp;
   sp.kind = sampler_kind::bayes;
   sp.regions.shared_cut_lights = 0;
@@ -192,7 +192,8 @@ three_lamps make_three_lamps(const bayes_params& bp) {
   f.pt = pixel_point(*f.t, 4, 4);
   f.ctx = std::make_unique<cut_context>();
   f.sampler().prepare(*f.ctx, f.pt);
-  REQUIRE(f.ctx->count == 3);
+  REQUIRE(f.ctx->count == (sun ? 4 : 3));
+  if (sun) REQUIRE(f.ctx->nodes[3] == sun_cluster);
   return f;
 }
 
@@ -990,12 +991,14 @@ TEST_CASE("under the mean hierarchy a fine pair's prior mean is the lower of its
   }
 }
 
-TEST_CASE("control variates apply at unweighted NEE to nearly always visible clusters", "[bayes]") {
-  // Cluster 0 is always visible with a steady contribution, cluster 1 is visible half the time, cluster 2 has no
-  // data. Where NEE is unweighted (sp.last) cluster 0 gets the control variate c = E[1 - p0] k g and the pmf the
-  // residual's weight sqrt(E[1 - p0] h + E[1 - p0] E[p0] k^2) g; clusters 1 and 2 (E[1 - p0] < cv_min_visible) keep
-  // the plain weight and c = 0. Elsewhere (MIS-weighted NEE) nothing changes.
-  three_lamps f = make_three_lamps(bayes_params{});
+TEST_CASE("control variates apply at unweighted NEE to clusters visible at least the threshold", "[bayes]") {
+  // With a lamp threshold of 0.96: cluster 0 is always visible with a steady contribution, cluster 1 is visible half
+  // the time, cluster 2 has no data. Where NEE is unweighted (sp.last) cluster 0 gets the control variate
+  // c = E[1 - p0] k g and the pmf the residual's weight sqrt(E[1 - p0] h + E[1 - p0] E[p0] k^2) g; clusters 1 and 2
+  // (E[1 - p0] < cv_min_visible) keep the plain weight and c = 0. Elsewhere (MIS-weighted NEE) nothing changes.
+  bayes_params bp;
+  bp.cv_min_visible = 0.96;
+  three_lamps f = make_three_lamps(bp);
   REQUIRE(f.sampler().params.control_variate);
   auto& t = f.t;
   bayes_sampler& s = f.sampler();
@@ -1048,5 +1051,52 @@ TEST_CASE("control variates apply at unweighted NEE to nearly always visible clu
       CHECK(s.cv_total(*ctx).x == Approx(cv_sum.x));
       CHECK(s.cv_total(*ctx).y == Approx(cv_sum.y));
     }
+  }
+}
+
+TEST_CASE("a lamp's control variate applies at any visibility, the sun's only where the region nearly always sees it",
+          "[bayes]") {
+  // Defaults: lamp 0 and the sun are each visible 90 % of the time with a steady contribution, lamps 1 and 2 have no
+  // data. Lamp 0 gets a control variate (E[1 - p0] above the lamps' threshold of 0), the sun none (below its own
+  // 0.96), lamps 1 and 2 none (no samples: no mean to subtract). With the sun's threshold at 0.85 it gets one too.
+  three_lamps f = make_three_lamps(bayes_params{}, true);
+  bayes_sampler& s = f.sampler();
+  REQUIRE(s.params.cv_min_visible == 0);
+  REQUIRE(s.params.cv_sun_min_visible == 0.96);
+  auto& ctx = f.ctx;
+  pcg32 rng(62, 9);
+  std::vector<bayes_row> rows(1);
+  for (int i = 0; i < 4000; i++)
+    for (int j : {0, 3}) {
+      light_choice c;
+      c.cluster = j;
+      float y = unif64(rng) < 0.1 ? 0.0f : float(0.3 * (1 + 0.05 * normal(rng)));
+      s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
+    }
+  s.learn(rows);
+  for (int j : {0, 3}) {
+    size_t i = size_t(ctx->pair_base + j);
+    double p1 = pair_p1(s.stats, i, s.regions.pair_parent[i], s.params);
+    INFO("cluster " << j << ": E[1 - p0] = " << p1);
+    CHECK(p1 > 0.85);
+    CHECK(p1 < 0.94);  // decisive: below the sun's threshold by far more than the posterior's spread
+  }
+  for (double sun_threshold : {0.96, 0.85}) {
+    INFO("the sun's threshold " << sun_threshold);
+    s.params.cv_sun_min_visible = sun_threshold;
+    s.refresh_all_weights();
+    shade_point q = f.pt;
+    q.last = true;
+    *ctx = cut_context{};
+    s.prepare(*ctx, q);
+    REQUIRE(ctx->cv);
+    REQUIRE(ctx->count == 4);
+    auto cv_of = [&](int j) { return s.stats.cv[size_t(ctx->pair_base + j)]; };
+    CHECK(cv_of(0) > 0);
+    CHECK(ctx->cvg[0] > 0);
+    CHECK(cv_of(1) == 0);
+    CHECK(cv_of(2) == 0);
+    CHECK((cv_of(3) > 0) == (sun_threshold < 0.9));
+    CHECK((ctx->cvg[3] > 0) == (sun_threshold < 0.9));
   }
 }
