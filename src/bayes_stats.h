@@ -53,10 +53,12 @@ struct bayes_params {
   bool mean_hierarchy = true;    // region prior with the hierarchy: a fine pair's prior mean of z is the lower of its
                                  // bound mu0 and its coarse parent's posterior mean (which pools the samples of all
                                  // its fine regions), so a new fine region starts from what its surroundings learned
-  double fallback_ratio = 1.25;  // fall back to power sampling for the rest of the render when the estimated relMSE
+  double fallback_ratio = 1.5;   // fall back to power sampling for the rest of the render when the estimated relMSE
                                  // per sample of power sampling is below this many times the learned one's in two
                                  // check windows in a row (from 4 spp on): where learning cannot pay for its own
                                  // cost (bayes costs 1.4-2.6x power's time per sample on the data/ scenes); 0: never
+                                 // (1.25 until the lamps' control variates raised the Cornell box's estimate to a
+                                 // hair under 2.5: README)
   double fallback_stratified = 2;  // the threshold's factor when the first vertex is stratified (the default): the
                                    // check estimates both sides as if samples were independent, but stratification
                                    // helps a fixed choice more (the Cornell box, direct: estimated 1.86x, about 1.3x

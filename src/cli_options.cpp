@@ -172,7 +172,7 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_option("--bayes-fallback-ratio", o.bayes.fallback_ratio,
                 "Fall back to power sampling for the rest of the render when its estimated relMSE per sample is below "
                 "this many times the learned sampler's in two checked passes in a row (from 4 spp on): where learning "
-                "cannot pay for its own cost (default 1.25; doubled unless --independent-samples, as the estimate "
+                "cannot pay for its own cost (default 1.5; doubled unless --independent-samples, as the estimate "
                 "assumes independent samples and stratification helps power sampling more; 0 = never)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-c", o.bayes.c,
