@@ -35,7 +35,7 @@ struct bayes_params {
                                  // so a shading point only scales each pair's posterior weight by 1 / d^2 (the
                                  // regression) and drops clusters behind its surface; false (ablation): mu0 from the
                                  // bound at every shading point, which then evaluates full cone bounds per cluster
-  double cv_min_visible = 0;      // control variates only for lamp pairs with E[1 - p0] at least this (README: any
+  double cv_min_visible = 0;     // control variates only for lamp pairs with E[1 - p0] at least this (README: any
                                  // visibility gained on the data/ scenes: a lamp's shadows are soft)
   double cv_sun_min_visible = 0.96;  // ... and for the sun's pairs (its shadow edges are sharp: 0.94 and below gave the
                                      // living room fireflies in dark pixels next to them)

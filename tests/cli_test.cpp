@@ -1077,6 +1077,8 @@ TEST_CASE("bayes options that its other options leave without effect are named i
            {"--bayes-prior point --bayes-no-orientation", "--bayes-no-orientation (region prior only"},
            {"--bayes-pmf mean --bayes-no-cv", "--bayes-no-cv (control variates need --bayes-pmf second-moment)"},
            {"--bayes-no-cv --bayes-cv-min-visible 0.5", "--bayes-cv-min-visible (no control variates with --bayes-no-cv)"},
+           {"--bayes-pmf mean --bayes-cv-sun-min-visible 0.5",
+            "--bayes-cv-sun-min-visible (control variates need --bayes-pmf second-moment)"},
            {"--bayes-hierarchy 0 --bayes-no-mean-hierarchy", "--bayes-no-mean-hierarchy (no hierarchy with"},
            {"--bayes-oracle 2 --pass-weighting 8", "--pass-weighting (a frozen --bayes-oracle model does not adapt)"},
            {"--sampler donikian --max-depth 1 --grid 3 --max-cut 2", "ignored: --grid (donikian's regions serve"},
@@ -1087,7 +1089,8 @@ TEST_CASE("bayes options that its other options leave without effect are named i
     CHECK(r.output.find(p.expect) != std::string::npos);
   }
   // Where they apply, no warning.
-  for (const char* options : {"--bayes-a0 2 --bayes-c 1 --bayes-no-orientation --bayes-cv-min-visible 0.5",
+  for (const char* options : {"--bayes-a0 2 --bayes-c 1 --bayes-no-orientation --bayes-cv-min-visible 0.5 "
+                              "--bayes-cv-sun-min-visible 0.9",
                               "--bayes-no-mean-hierarchy --pass-weighting 8", "--sampler donikian --max-depth 2 --grid 3"}) {
     auto r = run_bayeslight(base + " " + options);
     INFO(options << "\n" << r.output);
