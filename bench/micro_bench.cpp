@@ -507,7 +507,7 @@ void BM_refresh_weights(benchmark::State& state) {
   bayes_params p;
   bayes_stats s = random_stats(reduction_pairs, 1010);
   for (auto _ : state) {
-    refresh_weights(s, &parents, p);
+    refresh_weights(s, &parents, p, nullptr);  // (no sun)
     benchmark::ClobberMemory();
   }
   state.counters["ns_per_pair"] = per_item(state, double(reduction_pairs));

@@ -316,10 +316,10 @@ inline bool pair_state_finite(const bayes_stats& s, size_t i) {
   return ok;
 }
 // Folds every pair's p1 into its weight (parents: region_state::pair_parent, or nullptr for none; nodes:
-// region_state::pair_node, whose sun_cluster entries mark the sun's pairs, or nullptr for none): the sweep that ends
-// learning between passes.
+// region_state::pair_node, whose sun_cluster entries mark the sun's pairs, or nullptr where none is the sun): the
+// sweep that ends learning between passes.
 void refresh_weights(bayes_stats& s, const std::vector<int>* parents, const bayes_params& p,
-                     const std::vector<int>* nodes = nullptr);
+                     const std::vector<int>* nodes);
 // Weight of a pair for a point with prior mean v (= scale * bound) and g = 1 / d^2; 0 when v is 0.
 template <class H>
 inline double eval_weight(const H& h, const bayes_params& p, double v, double g) {

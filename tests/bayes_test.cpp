@@ -371,7 +371,7 @@ TEST_CASE("fast coefficient weights agree with the reference posterior", "[bayes
     // Clusters a region nearly never sees lit (p0 -> 1): E[1 - p0] of 1e-15 and less, which 1 - p0 formed from p0
     // would cancel (the reference did, 2x off at n0 = 1e15).
     for (int i = 5; i < pairs; i += 25) s.m[size_t(i)].n0 = i % 2 ? 1e15 : 1e13;
-    refresh_weights(s, nullptr, p);
+    refresh_weights(s, nullptr, p, nullptr);
     int worst_pair = -1;
     double worst = 0;
     for (int i = 0; i < pairs; i++)
@@ -553,12 +553,12 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
       std::vector<bayes_row> rows(1);
       for (auto [i, z] : stream) rows[0].add(i, z);
       merge_rows(s, rows, nullptr);
-      refresh_weights(s, nullptr, p);
+      refresh_weights(s, nullptr, p, nullptr);
     } else if (grouping == 1) {
       std::vector<bayes_row> rows(stream.size());
       for (size_t k = 0; k < stream.size(); k++) rows[k].add(stream[k].first, stream[k].second);
       merge_rows(s, rows, nullptr);
-      refresh_weights(s, nullptr, p);
+      refresh_weights(s, nullptr, p, nullptr);
     } else {
       size_t k = 0;
       for (int pass = 0; pass < 4; pass++) {
@@ -572,7 +572,7 @@ TEST_CASE("merging rows in any grouping gives the one pass statistics", "[bayes]
           CHECK(copy.acc.empty());
         }
         merge_rows(s, rows, nullptr);
-        refresh_weights(s, nullptr, p);
+        refresh_weights(s, nullptr, p, nullptr);
       }
     }
     for (int i = 0; i < pairs; i++) {
@@ -640,10 +640,10 @@ TEST_CASE("decaying statistics scales the counts and keeps the mean", "[bayes]")
   std::vector<bayes_row> rows(1);
   for (double z : {0.0, 1.0, 2.0, 0.0, 4.0}) rows[0].add(1, z);
   merge_rows(s, rows, nullptr);
-  refresh_weights(s, nullptr, p);
+  refresh_weights(s, nullptr, p, nullptr);
   double mean = s.m[1].mean, m2 = s.m[1].m2;
   decay_stats(s, 0.5);
-  refresh_weights(s, nullptr, p);
+  refresh_weights(s, nullptr, p, nullptr);
   CHECK(s.m[1].n0 == 1.0);
   CHECK(s.m[1].n1 == 1.5);
   CHECK(s.m[1].mean == mean);
@@ -900,7 +900,7 @@ TEST_CASE("fine pairs lean on their coarse parent as the hierarchy defines", "[b
     std::vector<bayes_row> more(1);
     for (int k = 0; k < 6; k++) more[0].add(s.regions.pair_offset[size_t(coarse)], 3.0 + k);
     merge_rows(s.stats, more, nullptr);
-    refresh_weights(s.stats, &s.regions.pair_parent, s.params);
+    refresh_weights(s.stats, &s.regions.pair_parent, s.params, &s.regions.pair_node);
     s.prepare(*ctx, pt);
     double w[3], own[3], sw = 0, sown = 0;
     for (int j = 0; j < 3; j++) {
@@ -971,7 +971,7 @@ TEST_CASE("under the mean hierarchy a fine pair's prior mean is the lower of its
     double low = 0.01 * s.stats.mu0[base];
     for (int k = 0; k < 40; k++) more[0].add(int(cbase), low * (1 + 0.01 * k));
     merge_rows(s.stats, more, nullptr);
-    refresh_weights(s.stats, &s.regions.pair_parent, s.params);
+    refresh_weights(s.stats, &s.regions.pair_parent, s.params, &s.regions.pair_node);
     const pair_moments& mp = s.stats.m[cbase];
     REQUIRE(mp.n1 == 42);
     double k_parent = (s.params.kappa0 * s.stats.mu0[cbase] + mp.n1 * mp.mean) / (s.params.kappa0 + mp.n1);

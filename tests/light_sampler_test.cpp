@@ -439,7 +439,7 @@ TEST_CASE("lazily refolded bayes weights stay within the refold tolerance of an 
     auto& s = std::get<bayes_sampler>(ls);
     learn_passes(t->in, s, 12);
     bayes_stats exact = s.stats;
-    refresh_weights(exact, &s.regions.pair_parent, s.params);
+    refresh_weights(exact, &s.regions.pair_parent, s.params, &s.regions.pair_node);
     int checked = 0, differ = 0;
     double worst = 0;
     for (size_t i = 0; i < s.stats.m.size(); i++) {
