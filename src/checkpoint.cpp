@@ -29,7 +29,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 17: the first vertex's BSDF direction in the render's stratified set
 // 18: the tiles' statistics of --light-points auto
 // 19: bayes's staged pass weights (the first passes' film where learning paid)
-constexpr uint32_t version = 20;  // 20: the sun's control-variate threshold apart from the lamps' (in the fingerprint)
+// 20: the sun's control-variate threshold apart from the lamps' (in the fingerprint)
+constexpr uint32_t version = 21;  // 21: bayes's early draws (in the fingerprint)
 
 }  // namespace
 
@@ -453,6 +454,9 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
     h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible), h.value(b.cv_sun_min_visible);
     h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
     h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
+    // The early draws, where they can apply (direct illumination; one draw or no early spp: none).
+    const bool early = p.max_depth == 1 && b.early_draws > std::max(1, p.light_samples) && b.early_spp > 0;
+    h.value(early ? b.early_draws : 0), h.value(early ? b.early_spp : 0);
   }
   h.begin(fp_donikian);
   if (k == sampler_kind::donikian) {

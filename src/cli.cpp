@@ -241,6 +241,18 @@ void warn_after_scene(const render_options& o, const render_params& params, cons
   if (deep_fine)
     std::fprintf(stderr, "bayeslight: warning: --fine-depth %d is above the max depth %d: depths past %d change nothing\n",
                  o.regions.fine_depth, max_depth, max_depth);
+  // bayes's early draws serve direct illumination only (max depth 1).
+  const bool bayes = std::find(kinds.begin(), kinds.end(), sampler_kind::bayes) != kinds.end();
+  if (bayes && max_depth > 1) {
+    std::string early;
+    for (const char* name : {"--bayes-early-draws", "--bayes-early-spp"})
+      if (given(name)) early += (early.empty() ? "" : ", ") + std::string(name);
+    if (!early.empty())
+      std::fprintf(stderr,
+                   "bayeslight: warning: options that change nothing in this run are ignored: %s (direct "
+                   "illumination only, and the max depth is %d)\n",
+                   early.c_str(), max_depth);
+  }
   if (!donikian || max_depth > 1) return;
   std::string unused;
   for (const auto& [name, group] : o.given) {

@@ -175,6 +175,15 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "cannot pay for its own cost (default 1.5; doubled unless --independent-samples, as the estimate "
                 "assumes independent samples and stratification helps power sampling more; 0 = never)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
+  r->add_option("--bayes-early-draws", o.bayes.early_draws,
+                "Direct illumination: NEE draws per camera sample (at least --light-samples) in the first "
+                "--bayes-early-spp spp, while the model learns most: those passes weigh little in the image, and a "
+                "draw costs less than the camera ray it shares (default 4; 1 = off)")
+      ->check(CLI::Range(1, 64))->group(bg);
+  r->add_option("--bayes-early-spp", o.bayes.early_spp,
+                "Direct illumination: passes that start before this many spp take --bayes-early-draws (default 16; "
+                "0 = off)")
+      ->check(CLI::Range(0, 1 << 30))->group(bg);
   r->add_option("--bayes-c", o.bayes.c,
                 "Prior squared coefficient of variation: beta0 = c mu0^2 (alpha0 - 1) (1e-6 to 1e6, default 0.3)")
       ->check(CLI::Range(1e-6, 1e6))->check(finite_number)->group(bg);

@@ -23,7 +23,8 @@ constexpr double z_crit = 4.4;
 // Renders an in-memory scene and returns the per-pixel luminance-free red channel estimates.
 std::vector<double> render_pixels(mesh_data mesh, const camera_params& cam, const sun_params& sun, bool two_sided,
                                   sampler_kind kind, int max_depth, int spp, int size = 8, uint64_t seed = 1,
-                                  int light_samples = 1, int light_points = 1) {
+                                  int light_samples = 1, int light_points = 1,
+                                  int early_draws = bayes_params{}.early_draws) {
   scene_data scene = build_scene(std::move(mesh), cam, sun, two_sided, 1.0f);
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
@@ -36,6 +37,7 @@ std::vector<double> render_pixels(mesh_data mesh, const camera_params& cam, cons
   p.sampler.kind = kind;
   p.light_samples = light_samples;
   p.light_points = light_points;
+  p.sampler.bayes.early_draws = early_draws;
   render_result r = render(scene, bvh, lights, p);
   std::vector<double> red;  // the film's own mean, in double
   for (int i = 0; i < size * size; i++) red.push_back(r.film[3 * size_t(i)] / r.film_weight);
@@ -497,16 +499,61 @@ TEST_CASE("light samples per vertex are drawn apart: four cut the pixels' spread
   // K draws that repeated one light choice or point would average to the same estimate with the same noise. Direct
   // illumination under a square lamp, with a lamp facing away that the fixed samplers waste draws on: the pixels'
   // standard deviation with four draws against one, at the same spp. Independent draws give 1/2 (stratified, less);
-  // the bound 0.7 leaves the spread's own sampling error (64 pixels: about 9 % each) more than 3 sigma.
+  // the bound 0.7 leaves the spread's own sampling error (64 pixels: about 9 % each) more than 3 sigma. (bayes without
+  // its early draws, which would give both renders four.)
   const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
   const mesh_data mesh = square_lamp_mesh(a, h, le, rho, 50);
   for (sampler_kind kind : kinds) {
-    mean_se one = mean_and_se(render_pixels(mesh, looking_down(h / 2), {}, false, kind, 1, 16, 8, 3, 1));
-    mean_se four = mean_and_se(render_pixels(mesh, looking_down(h / 2), {}, false, kind, 1, 16, 8, 3, 4));
+    mean_se one = mean_and_se(render_pixels(mesh, looking_down(h / 2), {}, false, kind, 1, 16, 8, 3, 1, 1, 1));
+    mean_se four = mean_and_se(render_pixels(mesh, looking_down(h / 2), {}, false, kind, 1, 16, 8, 3, 4, 1, 1));
     INFO("sampler " << sampler_name(kind) << " se with 1: " << one.se << " with 4: " << four.se);
     CHECK(one.se > 0);
     CHECK(four.se < 0.7 * one.se);
   }
+}
+
+TEST_CASE("bayes draws its early NEE samples in a direct render's first passes only, and not once it fell back",
+          "[analytic]") {
+  // --bayes-early-draws 4 (the default) in the passes that start before --bayes-early-spp 16: here the first 18 spp
+  // (passes of 1 spp to 8, then 8-10, 10-12, 12-15, 15-18). Every camera ray meets the floor, so a render of 20 spp
+  // takes 4 draws per pixel in each of its first 18 spp and 1 in the last 2. A path-traced render takes one draw
+  // throughout, and so does a render after its fallback to power sampling (forced here at 5 spp).
+  const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
+  scene_data scene = build_scene(square_lamp_mesh(a, h, le, rho, 50), looking_down(h / 2), {}, false, 1.0f);
+  bvh_data bvh = build_bvh(scene);
+  light_data lights = build_lights(scene);
+  render_params p;
+  p.width = p.height = 4;
+  p.spp = 20;
+  p.max_depth = 1;
+  p.seed = 5;
+  p.threads = 2;
+  p.sampler.kind = sampler_kind::bayes;
+  const uint64_t pixels = 16;
+  int early = 0;  // the spp of the passes that start before early_spp
+  for (int pass = 0, done = 0; done < p.sampler.bayes.early_spp; pass++) {
+    done += pass_size(pass, done, int64_t(pixels));
+    early = done;
+  }
+  REQUIRE(early == 18);
+  auto draws = [&](int early_draws, int max_depth, double fallback_ratio) {
+    render_params q = p;
+    q.sampler.bayes.early_draws = early_draws;
+    q.max_depth = max_depth;
+    if (fallback_ratio > 0) q.sampler.bayes.fallback_ratio = fallback_ratio, q.sampler.bayes.fallback_window = 1;
+    render_result r = render(scene, bvh, lights, q);
+    INFO("early draws " << early_draws << " max depth " << max_depth << " fallback after " << r.fallback_spp);
+    CHECK(r.stats.camera_rays == pixels * 20);
+    if (fallback_ratio > 0) CHECK(r.fallback_spp == 5);
+    return r;
+  };
+  CHECK(draws(1, 1, 0).stats.nee_samples == pixels * 20);
+  CHECK(draws(4, 1, 0).stats.nee_samples == pixels * (4 * uint64_t(early) + 20 - uint64_t(early)));
+  CHECK(draws(4, 1, 1e9).stats.nee_samples == pixels * (4 * 5 + 15));
+  // Path traced: the same image with or without them.
+  render_result one = draws(1, 2, 0), four = draws(4, 2, 0);
+  CHECK(four.stats.nee_samples == one.stats.nee_samples);
+  CHECK(four.film == one.film);
 }
 
 TEST_CASE("a two-sided lamp lights the floor its back faces, with every sampler", "[analytic]") {

@@ -327,7 +327,13 @@ TEST_CASE("resuming with options of another sampler is accepted and changes noth
                            variant{"bayes --bayes-naive", " --bayes-a0 2 --bayes-c 0.5", " --bayes-epsilon 0.1"},
                            variant{"bayes --bayes-prior point", " --bayes-no-cv --bayes-no-orientation", " --bayes-b0 2"},
                            variant{"bayes --bayes-no-cv", " --bayes-cv-min-visible 0.5", " --bayes-c 0.5"},
-                           variant{"bayes --bayes-oracle 3", " --pass-weighting 8", " --bayes-c 0.5"}}) {
+                           variant{"bayes --bayes-oracle 3", " --pass-weighting 8", " --bayes-c 0.5"},
+                           // bayes's early draws: direct illumination only, and none at or below --light-samples (the
+                           // checkpoint after 5 passes lies inside the first 16 spp, where they apply)
+                           variant{"bayes", " --bayes-early-draws 2 --bayes-early-spp 4", " --pass-weighting 0"},
+                           variant{"bayes --max-depth 1", " --bayes-early-draws 4", " --bayes-early-draws 2"},
+                           variant{"bayes --max-depth 1 --light-samples 4", " --bayes-early-draws 2",
+                                   " --bayes-early-draws 8"}}) {
     temp_dir d;
     std::string ck = d / "ck.bin", full = d / "full.pfm", part = d / "part.pfm";
     INFO(v.sampler);

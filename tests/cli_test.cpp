@@ -1066,7 +1066,8 @@ TEST_CASE("options that change nothing in a run are named in a warning", "[cli]"
 TEST_CASE("bayes options that its other options leave without effect are named in a warning", "[cli]") {
   // Each of these left the image bit for bit unchanged without a word (a review): the prior strengths under
   // --bayes-naive, the region prior's switches under --bayes-prior point, control-variate options without them, the
-  // mean hierarchy without the hierarchy, pass weighting of a frozen oracle model, and donikian's regions at depth 1.
+  // mean hierarchy without the hierarchy, pass weighting of a frozen oracle model, and donikian's regions at depth 1;
+  // bayes's early draws in a path-traced render.
   tiny_scene s;
   const std::string base = "render " + s.json + " --spp 2 --quiet -o " + (s.dir / "a.pfm");
   struct probe {
@@ -1082,6 +1083,8 @@ TEST_CASE("bayes options that its other options leave without effect are named i
            {"--bayes-hierarchy 0 --bayes-no-mean-hierarchy", "--bayes-no-mean-hierarchy (no hierarchy with"},
            {"--bayes-oracle 2 --pass-weighting 8", "--pass-weighting (a frozen --bayes-oracle model does not adapt)"},
            {"--sampler donikian --max-depth 1 --grid 3 --max-cut 2", "ignored: --grid (donikian's regions serve"},
+           {"--max-depth 2 --bayes-early-draws 2 --bayes-early-spp 8",
+            "ignored: --bayes-early-draws, --bayes-early-spp (direct illumination only, and the max depth is 2)"},
        }) {
     auto r = run_bayeslight(base + " " + p.options);
     INFO(p.options << "\n" << r.output);
@@ -1091,7 +1094,8 @@ TEST_CASE("bayes options that its other options leave without effect are named i
   // Where they apply, no warning.
   for (const char* options : {"--bayes-a0 2 --bayes-c 1 --bayes-no-orientation --bayes-cv-min-visible 0.5 "
                               "--bayes-cv-sun-min-visible 0.9",
-                              "--bayes-no-mean-hierarchy --pass-weighting 8", "--sampler donikian --max-depth 2 --grid 3"}) {
+                              "--bayes-no-mean-hierarchy --pass-weighting 8", "--sampler donikian --max-depth 2 --grid 3",
+                              "--max-depth 1 --bayes-early-draws 2 --bayes-early-spp 8"}) {
     auto r = run_bayeslight(base + " " + options);
     INFO(options << "\n" << r.output);
     CHECK(r.status == 0);
