@@ -301,8 +301,9 @@ bool model_moves(const Sampler& s) {
 // early_draws in its first early_spp spp while it learns (unless its check fell back, or its model is frozen):
 // those passes weigh little in the image (staged_pass_weight) but decide the model every later pass samples from,
 // and a draw costs less than the camera ray and shading it shares with the others. Living room, direct, 400 spp,
-// seeds 11-13: relMSE 0.85x of one draw throughout (README, "Why these defaults"). A function of the spp done:
-// a --time render stays the --spp render of its samples.
+// seeds 11-13: relMSE 0.78-0.88x of one draw throughout (README, "Choosing the defaults"). A function of the spp
+// done and of the model's state, which a checkpoint keeps: a --time or resumed render stays the --spp render of its
+// samples.
 template <class Sampler>
 int pass_draws(const Sampler& s, const render_params& params, int done, int draws) {
   if constexpr (std::is_same_v<Sampler, bayes_sampler>) {
