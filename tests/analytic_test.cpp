@@ -6,6 +6,7 @@
 #include "lights.h"
 #include "render.h"
 #include "scene.h"
+#include "scene_fixture.h"
 #include "test_util.h"
 #include "texture.h"
 
@@ -519,9 +520,7 @@ TEST_CASE("bayes draws its early NEE samples in a direct render's first passes o
   // takes 4 draws per pixel in each of its first 18 spp and 1 in the last 2. A path-traced render takes one draw
   // throughout, and so does a render after its fallback to power sampling (forced here at 5 spp).
   const float a = 1.0f, h = 0.5f, le = 2.0f, rho = 0.5f;
-  scene_data scene = build_scene(square_lamp_mesh(a, h, le, rho, 50), looking_down(h / 2), {}, false, 1.0f);
-  bvh_data bvh = build_bvh(scene);
-  light_data lights = build_lights(scene);
+  const auto t = build_test_scene(square_lamp_mesh(a, h, le, rho, 50), looking_down(h / 2));
   render_params p;
   p.width = p.height = 4;
   p.spp = 20;
@@ -541,7 +540,7 @@ TEST_CASE("bayes draws its early NEE samples in a direct render's first passes o
     q.sampler.bayes.early_draws = early_draws;
     q.max_depth = max_depth;
     if (fallback_ratio > 0) q.sampler.bayes.fallback_ratio = fallback_ratio, q.sampler.bayes.fallback_window = 1;
-    render_result r = render(scene, bvh, lights, q);
+    render_result r = render(t->scene, t->bvh, t->lights, q);
     INFO("early draws " << early_draws << " max depth " << max_depth << " fallback after " << r.fallback_spp);
     CHECK(r.stats.camera_rays == pixels * 20);
     if (fallback_ratio > 0) CHECK(r.fallback_spp == 5);
