@@ -67,7 +67,7 @@ struct bayes_params {
   double fallback_window = 262144;  // samples (pixels x spp) a fallback check sums before it votes: the events that
                                     // make power sampling bad can be rare (points by a lamp's rim)
   int early_draws = 4;           // a direct render's NEE draws per camera sample in its first early_spp spp (render.cpp,
-  int early_spp = 16;            // pass_draws): the passes it learns most from; 1 or 0 spp: one draw throughout
+  int early_spp = 16;            // pass_draws): the passes it learns most from; draws at most light_samples, or 0 spp: off
   bool control_variate = true;   // region prior only: where NEE is unweighted (direct illumination, the last path
                                  // vertex), add the learned mean c_j = E[1 - p0] k_j / d^2 of every cluster and
                                  // estimate the residual (Y_J - c_J) / P_J, with P_j proportional to the root of the

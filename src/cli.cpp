@@ -241,7 +241,9 @@ void warn_after_scene(const render_options& o, const render_params& params, cons
   if (deep_fine)
     std::fprintf(stderr, "bayeslight: warning: --fine-depth %d is above the max depth %d: depths past %d change nothing\n",
                  o.regions.fine_depth, max_depth, max_depth);
-  // bayes's early draws serve direct illumination only (max depth 1).
+  // bayes's early draws serve direct illumination only (max depth 1), and only where they take more draws than
+  // --light-samples over a span of at least one spp (render.cpp, pass_draws; the checkpoint fingerprint reads them
+  // the same way).
   const bool bayes = std::find(kinds.begin(), kinds.end(), sampler_kind::bayes) != kinds.end();
   if (bayes && max_depth > 1) {
     std::string early;
@@ -252,6 +254,23 @@ void warn_after_scene(const render_options& o, const render_params& params, cons
                    "bayeslight: warning: options that change nothing in this run are ignored: %s (direct "
                    "illumination only, and the max depth is %d)\n",
                    early.c_str(), max_depth);
+  } else if (bayes) {
+    const int per_sample = std::max(1, o.light_samples);
+    const bayes_params defaults;
+    auto takes_effect = [&](int draws, int spp) { return draws > per_sample && spp > 0; };
+    const int draws = o.bayes.early_draws, spp = o.bayes.early_spp;
+    // An option is ignored where neither its value nor its default would make the early draws happen.
+    if (given("--bayes-early-draws") && !takes_effect(draws, spp) && !takes_effect(defaults.early_draws, spp))
+      std::fprintf(stderr,
+                   "bayeslight: warning: options that change nothing in this run are ignored: --bayes-early-draws (%s)\n",
+                   spp == 0 ? "--bayes-early-spp 0 turns the early draws off"
+                            : ("every camera sample takes --light-samples " + std::to_string(per_sample) +
+                               " draws already").c_str());
+    if (given("--bayes-early-spp") && !takes_effect(draws, spp) && !takes_effect(draws, defaults.early_spp))
+      std::fprintf(stderr,
+                   "bayeslight: warning: options that change nothing in this run are ignored: --bayes-early-spp "
+                   "(--bayes-early-draws %d is not above --light-samples %d)\n",
+                   draws, per_sample);
   }
   if (!donikian || max_depth > 1) return;
   std::string unused;

@@ -1085,6 +1085,14 @@ TEST_CASE("bayes options that its other options leave without effect are named i
            {"--sampler donikian --max-depth 1 --grid 3 --max-cut 2", "ignored: --grid (donikian's regions serve"},
            {"--max-depth 2 --bayes-early-draws 2 --bayes-early-spp 8",
             "ignored: --bayes-early-draws, --bayes-early-spp (direct illumination only, and the max depth is 2)"},
+           {"--max-depth 1 --bayes-early-draws 8 --bayes-early-spp 0",
+            "ignored: --bayes-early-draws (--bayes-early-spp 0 turns the early draws off)"},
+           {"--max-depth 1 --light-samples 4 --bayes-early-draws 3",
+            "ignored: --bayes-early-draws (every camera sample takes --light-samples 4 draws already)"},
+           {"--max-depth 1 --bayes-early-draws 1 --bayes-early-spp 8",
+            "ignored: --bayes-early-spp (--bayes-early-draws 1 is not above --light-samples 1)"},
+           {"--max-depth 1 --light-samples 8 --bayes-early-spp 4",
+            "ignored: --bayes-early-spp (--bayes-early-draws 4 is not above --light-samples 8)"},
        }) {
     auto r = run_bayeslight(base + " " + p.options);
     INFO(p.options << "\n" << r.output);
@@ -1095,7 +1103,12 @@ TEST_CASE("bayes options that its other options leave without effect are named i
   for (const char* options : {"--bayes-a0 2 --bayes-c 1 --bayes-no-orientation --bayes-cv-min-visible 0.5 "
                               "--bayes-cv-sun-min-visible 0.9",
                               "--bayes-no-mean-hierarchy --pass-weighting 8", "--sampler donikian --max-depth 2 --grid 3",
-                              "--max-depth 1 --bayes-early-draws 2 --bayes-early-spp 8"}) {
+                              "--max-depth 1 --bayes-early-draws 2 --bayes-early-spp 8",
+                              // each turns the default's early draws off
+                              "--max-depth 1 --bayes-early-draws 1", "--max-depth 1 --bayes-early-spp 0",
+                              "--max-depth 1 --light-samples 2 --bayes-early-draws 2",
+                              // more draws than --light-samples, where the default's are not
+                              "--max-depth 1 --light-samples 4 --bayes-early-draws 6 --bayes-early-spp 2"}) {
     auto r = run_bayeslight(base + " " + options);
     INFO(options << "\n" << r.output);
     CHECK(r.status == 0);
