@@ -51,7 +51,8 @@ static bool unit_normal(vec3f vn, vec3f& out) {
 
 // Index of the texture for (mtl, line, name) in mesh.textures, loading it on first use of its file.
 static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, folder_cache& folders,
-                         const std::string& mtl_path, int line, const char* statement, const std::string& name) {
+                         const std::string& obj_path, const std::string& mtl_path, int line, const char* statement,
+                         const std::string& name) {
   if (name.empty()) return invalid_id;
   const std::string dir = fs::path(mtl_path).parent_path().string();
   const std::string written = resolve_file_name(dir, name);
@@ -64,6 +65,13 @@ static int texture_index(mesh_data& mesh, std::map<std::string, int>& loaded, fo
     // file beside the MTL (find_beside: in its last folder, then alone), said once per name (later references find it
     // in `loaded`).
     std::string beside = find_beside(dir, name, folders);
+    // An MTL in a subfolder (mtllib materials/a.mtl) whose textures were named from the OBJ's folder, as some
+    // exporters and readers take them: there, as written, then as find_beside looks.
+    const std::string obj_dir = fs::path(obj_path).parent_path().string();
+    if (beside.empty() && fs::path(obj_dir).lexically_normal() != fs::path(dir).lexically_normal()) {
+      const std::string from_obj = resolve_file_name(obj_dir, name);
+      beside = fs::is_regular_file(from_obj, ec) ? from_obj : find_beside(obj_dir, name, folders);
+    }
     if (!beside.empty()) {
       folders.note(mtl_path, line, statement, name, beside);
       path = beside;
@@ -361,8 +369,10 @@ static mesh_data build_mesh(const std::string& path, const obj_clean_data& clean
   std::map<std::string, int> loaded;
   for (const auto& m : clean.materials) {
     material_data md = m.material;
-    md.kd_texture = texture_index(mesh, loaded, clean.folders, m.mtl_path, m.kd_map_line, "map_Kd", m.kd_map);
-    md.alpha_texture = texture_index(mesh, loaded, clean.folders, m.mtl_path, m.alpha_map_line, "map_d", m.alpha_map);
+    md.kd_texture =
+        texture_index(mesh, loaded, clean.folders, path, m.mtl_path, m.kd_map_line, "map_Kd", m.kd_map);
+    md.alpha_texture =
+        texture_index(mesh, loaded, clean.folders, path, m.mtl_path, m.alpha_map_line, "map_d", m.alpha_map);
     md.kd_is_cutout =
         md.kd_texture != invalid_id && md.alpha_texture == md.kd_texture && same_lookup(md.kd_map, md.alpha_map);
     mesh.materials.push_back(md);

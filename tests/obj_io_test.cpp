@@ -782,6 +782,39 @@ TEST_CASE("a texture written with another machine's path is taken from its folde
                                    "/textures/wood.png\n"));
 }
 
+TEST_CASE("a texture of an MTL in a subfolder, named from the OBJ's folder, is found there", "[obj]") {
+  // A review: mtllib mats/a.mtl whose map_Kd tex2.png lies beside the OBJ was refused ("mats/tex2.png: cannot open
+  // image"), though the case-, backslash- and folder-tolerant look-ups beside the MTL were tried.
+  temp_dir dir;
+  std::filesystem::create_directory(dir.path + "/mats");
+  std::filesystem::create_directory(dir.path + "/textures");
+  write_png(dir, "tex2.png");
+  write_png(dir, "textures/wood.png");
+  write_png(dir, "Leaf.png");
+  dir.write("mats/a.mtl", "newmtl a\nmap_Kd tex2.png\nnewmtl b\nmap_Kd textures/wood.png\nmap_d LEAF.png\n");
+  mesh_data m;
+  std::string said = load_warnings(dir.write("sub.obj", "mtllib mats/a.mtl\n" + std::string(square_vertices) +
+                                                            "usemtl a\nf 1 2 3\nusemtl b\nf 1 3 4\n"),
+                                   &m);
+  REQUIRE(m.materials.size() == 2);
+  REQUIRE(m.textures.size() == 3);
+  CHECK(std::filesystem::equivalent(m.textures[size_t(m.materials[0].kd_texture)].path, dir.path + "/tex2.png"));
+  CHECK(std::filesystem::equivalent(m.textures[size_t(m.materials[1].kd_texture)].path,
+                                    dir.path + "/textures/wood.png"));
+  CHECK(std::filesystem::equivalent(m.textures[size_t(m.materials[1].alpha_texture)].path,
+                                    dir.path + "/Leaf.png"));  // (in another case, too)
+  CHECK_THAT(said, Catch::Contains("a.mtl:2: map_Kd: tex2.png does not exist; using "));
+  // Beside the MTL first, where both hold one.
+  write_png(dir, "mats/tex2.png");
+  mesh_data both = load_obj(dir.path + "/sub.obj");
+  CHECK(std::filesystem::equivalent(both.textures[size_t(both.materials[0].kd_texture)].path,
+                                    dir.path + "/mats/tex2.png"));
+  // Found in neither: the error names the file as written beside the MTL.
+  dir.write("mats/c.mtl", "newmtl a\nmap_Kd stone.png\n");
+  auto bad = dir.write("c.obj", "mtllib mats/c.mtl\n" + std::string(square_vertices) + "usemtl a\nf 1 2 3\n");
+  CHECK_THAT(load_error(bad), Catch::Contains("stone.png"));
+}
+
 TEST_CASE("MTL statements that are not rendered are accepted in any of their forms", "[obj]") {
   temp_dir dir;
   write_png(dir, "glow.png");
