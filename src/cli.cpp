@@ -259,14 +259,25 @@ void warn_after_scene(const render_options& o, const render_params& params, cons
     const bayes_params defaults;
     auto takes_effect = [&](int draws, int spp) { return draws > per_sample && spp > 0; };
     const int draws = o.bayes.early_draws, spp = o.bayes.early_spp;
-    // An option is ignored where neither its value nor its default would make the early draws happen.
-    if (given("--bayes-early-draws") && !takes_effect(draws, spp) && !takes_effect(defaults.early_draws, spp))
+    // An option is ignored where neither its value nor its default would make the early draws happen, the other
+    // option as given. Where each would be so without the other (--bayes-early-draws 1 --bayes-early-spp 0), neither
+    // is: both turn the early draws off, and dropping both would bring them back.
+    const bool draws_idle = given("--bayes-early-draws") && !takes_effect(draws, spp) &&
+                            !takes_effect(defaults.early_draws, spp);
+    const bool spp_idle = given("--bayes-early-spp") && !takes_effect(draws, spp) &&
+                          !takes_effect(draws, defaults.early_spp);
+    if (draws_idle && spp_idle)
+      std::fprintf(stderr,
+                   "bayeslight: warning: --bayes-early-draws %d and --bayes-early-spp 0 each turn the early draws "
+                   "off: one of them is enough\n",
+                   draws);
+    else if (draws_idle)
       std::fprintf(stderr,
                    "bayeslight: warning: options that change nothing in this run are ignored: --bayes-early-draws (%s)\n",
                    spp == 0 ? "--bayes-early-spp 0 turns the early draws off"
                             : ("every camera sample takes --light-samples " + std::to_string(per_sample) +
                                " draws already").c_str());
-    if (given("--bayes-early-spp") && !takes_effect(draws, spp) && !takes_effect(draws, defaults.early_spp))
+    else if (spp_idle)
       std::fprintf(stderr,
                    "bayeslight: warning: options that change nothing in this run are ignored: --bayes-early-spp "
                    "(--bayes-early-draws %d is not above --light-samples %d)\n",

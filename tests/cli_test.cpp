@@ -1093,11 +1093,17 @@ TEST_CASE("bayes options that its other options leave without effect are named i
             "ignored: --bayes-early-spp (--bayes-early-draws 1 is not above --light-samples 1)"},
            {"--max-depth 1 --light-samples 8 --bayes-early-spp 4",
             "ignored: --bayes-early-spp (--bayes-early-draws 4 is not above --light-samples 8)"},
+           // (each alone changes nothing; dropping both would turn the early draws back on: not "ignored")
+           {"--max-depth 1 --bayes-early-draws 1 --bayes-early-spp 0",
+            "--bayes-early-draws 1 and --bayes-early-spp 0 each turn the early draws off: one of them is enough"},
        }) {
     auto r = run_bayeslight(base + " " + p.options);
     INFO(p.options << "\n" << r.output);
     CHECK(r.status == 0);
     CHECK(r.output.find(p.expect) != std::string::npos);
+    if (p.options.find("--bayes-early-spp 0") != std::string::npos &&
+        p.options.find("--bayes-early-draws 1") != std::string::npos)
+      CHECK(r.output.find("ignored") == std::string::npos);
   }
   // Where they apply, no warning.
   for (const char* options : {"--bayes-a0 2 --bayes-c 1 --bayes-no-orientation --bayes-cv-min-visible 0.5 "
