@@ -30,7 +30,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 18: the tiles' statistics of --light-points auto
 // 19: bayes's staged pass weights (the first passes' film where learning paid)
 // 20: the sun's control-variate threshold apart from the lamps' (in the fingerprint)
-constexpr uint32_t version = 21;  // 21: bayes's early draws (in the fingerprint)
+// 21: bayes's early draws (in the fingerprint)
+constexpr uint32_t version = 22;  // 22: Russian roulette's survival probability (path-traced images changed)
 
 }  // namespace
 
