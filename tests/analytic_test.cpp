@@ -21,11 +21,11 @@ namespace {
 
 constexpr double z_crit = 4.4;
 
-// Renders an in-memory scene and returns the per-pixel luminance-free red channel estimates.
-std::vector<double> render_pixels(mesh_data mesh, const camera_params& cam, const sun_params& sun, bool two_sided,
-                                  sampler_kind kind, int max_depth, int spp, int size = 8, uint64_t seed = 1,
-                                  int light_samples = 1, int light_points = 1,
-                                  int early_draws = bayes_params{}.early_draws) {
+// Renders an in-memory scene (size x size pixels, 2 threads): its film, film weight and path statistics.
+render_result render_in_memory(mesh_data mesh, const camera_params& cam, const sun_params& sun, bool two_sided,
+                               sampler_kind kind, int max_depth, int spp, int size = 8, uint64_t seed = 1,
+                               int light_samples = 1, int light_points = 1,
+                               int early_draws = bayes_params{}.early_draws) {
   scene_data scene = build_scene(std::move(mesh), cam, sun, two_sided, 1.0f);
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
@@ -39,7 +39,16 @@ std::vector<double> render_pixels(mesh_data mesh, const camera_params& cam, cons
   p.light_samples = light_samples;
   p.light_points = light_points;
   p.sampler.bayes.early_draws = early_draws;
-  render_result r = render(scene, bvh, lights, p);
+  return render(scene, bvh, lights, p);
+}
+
+// Renders an in-memory scene and returns the per-pixel luminance-free red channel estimates.
+std::vector<double> render_pixels(mesh_data mesh, const camera_params& cam, const sun_params& sun, bool two_sided,
+                                  sampler_kind kind, int max_depth, int spp, int size = 8, uint64_t seed = 1,
+                                  int light_samples = 1, int light_points = 1,
+                                  int early_draws = bayes_params{}.early_draws) {
+  render_result r = render_in_memory(std::move(mesh), cam, sun, two_sided, kind, max_depth, spp, size, seed,
+                                     light_samples, light_points, early_draws);
   std::vector<double> red;  // the film's own mean, in double
   for (int i = 0; i < size * size; i++) red.push_back(r.film[3 * size_t(i)] / r.film_weight);
   return red;
@@ -333,18 +342,28 @@ TEST_CASE("a wall thinner than the default ray offset still shadows a point besi
 namespace {
 // A closed sphere of 32 x 32 faces, each emitting Le = 1 (two-sided) with albedo rho, seen from its centre: the
 // radiance is sum_{k=0..depth} rho^k (see the test below for why a sphere).
-void check_furnace(float rho, sampler_kind kind, int depth, int spp, int size) {
+// A closed sphere of radius 1 whose grey walls (albedo rho) emit 1, seen from its centre.
+struct furnace_scene {
+  mesh_data mesh;
+  camera_params cam;
+};
+furnace_scene furnace_of(float rho) {
   mesh_builder b;
   int wall = b.add_material({rho, rho, rho}, {1, 1, 1});
   b.add_sphere({0, 0, 0}, 1, 32, wall);
-  camera_params cam;
-  cam.automatic = false;
-  cam.eye = {0, 0, 0};
-  cam.target = {0, 0, 1};
-  cam.fov_y_deg = 12;
+  furnace_scene f{b.mesh, {}};
+  f.cam.automatic = false;
+  f.cam.eye = {0, 0, 0};
+  f.cam.target = {0, 0, 1};
+  f.cam.fov_y_deg = 12;
+  return f;
+}
+
+void check_furnace(float rho, sampler_kind kind, int depth, int spp, int size) {
+  furnace_scene f = furnace_of(rho);
   double exact = 0;
   for (int k = 0; k <= depth; k++) exact += std::pow(rho, k);
-  check_estimate(render_pixels(b.mesh, cam, {}, true, kind, depth, spp, size), exact);
+  check_estimate(render_pixels(f.mesh, f.cam, {}, true, kind, depth, spp, size), exact);
 }
 }  // namespace
 
@@ -375,25 +394,8 @@ TEST_CASE("Russian roulette spares paths of throughput at least a third", "[anal
   // vertex 4: 2 + 3/8 + 3/16 = 2.5625 (with the scale 1 before: 2.1875; without roulette: 4). 32768 paths: the
   // standard error of the mean is about 0.004.
   for (float rho : {0.8f, 0.5f}) {
-    mesh_builder b;
-    int wall = b.add_material({rho, rho, rho}, {1, 1, 1});
-    b.add_sphere({0, 0, 0}, 1, 32, wall);
-    camera_params cam;
-    cam.automatic = false;
-    cam.eye = {0, 0, 0};
-    cam.target = {0, 0, 1};
-    cam.fov_y_deg = 12;
-    scene_data scene = build_scene(std::move(b.mesh), cam, {}, true, 1.0f);
-    bvh_data bvh = build_bvh(scene);
-    light_data lights = build_lights(scene);
-    render_params p;
-    p.width = p.height = 8;
-    p.spp = 512;
-    p.max_depth = 5;
-    p.seed = 7;
-    p.threads = 2;
-    p.sampler.kind = sampler_kind::uniform;
-    render_result r = render(scene, bvh, lights, p);
+    furnace_scene f = furnace_of(rho);
+    render_result r = render_in_memory(f.mesh, f.cam, {}, true, sampler_kind::uniform, 5, 512, 8, 7);
     REQUIRE(r.stats.camera_rays == 8 * 8 * 512);
     const double per_path = double(r.stats.bounce_rays) / double(r.stats.camera_rays);
     INFO("rho " << rho << ": " << per_path << " bounce rays per path");
