@@ -152,10 +152,6 @@ inline hit_info camera_hit(const render_inputs& in, vec3f d) {
   return continuation_hit(in, h.tri, in.camera.eye, scene.tri_ng[size_t(h.tri)], d);
 }
 
-// Radiance of sample `sample` of pixel (x, y). `ctxs` are the light-selection contexts of the current and the
-// previous vertex (alternating by depth); the caller keeps them across samples of a row, so that samplers can
-// reuse per-point work between neighbouring samples (e.g. a region lookup). `tm` times the hot path's stages
-// (profile_timers.h; no_timers compiles every timer away).
 // Russian roulette from the third vertex keeps a path with probability min(1, roulette_scale * max(beta)): a path
 // whose throughput is at least 1 / roulette_scale always goes on, and a survivor's throughput is raised to that level,
 // not to 1. With 1 (pbrt-v4's rule), paths that crossed a dark wall into a room of bright lamps (the plant room's
@@ -166,6 +162,10 @@ inline hit_info camera_hit(const render_inputs& in, vec3f d) {
 // light sampler).
 constexpr float roulette_scale = 3.0f;
 
+// Radiance of sample `sample` of pixel (x, y). `ctxs` are the light-selection contexts of the current and the
+// previous vertex (alternating by depth); the caller keeps them across samples of a row, so that samplers can
+// reuse per-point work between neighbouring samples (e.g. a region lookup). `tm` times the hot path's stages
+// (profile_timers.h; no_timers compiles every timer away).
 template <class Sampler, class Sink, class Timers>
 vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, int y, const pixel_streams& ps,
                        uint64_t sample, path_stats& st, Sink& sink, typename Sampler::context (&ctxs)[2], Timers& tm,
