@@ -300,6 +300,7 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
     double q = power.pmf({}, e.choice.light);
     double with_power = a == 0 ? 0.0 : q > 0 ? a * a * p / q : HUGE_VAL;
     px_delta[size_t(e.pixel)] += with_power - double(e.added_total) * e.added_total;
+    if (e.first_vertex && !px_first.empty()) px_first[size_t(e.pixel)] += with_power;
   }
   const cut_context& ctx = *e.context;
   row.requests.add(ctx);
@@ -496,11 +497,20 @@ void bayes_sampler::flush_check(const row_state& row) const {
 }
 
 void bayes_sampler::restart_check() {
-  px_var = px_delta = {};
+  px_var = px_delta = px_first = {};
   px_prev = px_cur = {};
   fallback_votes = 0;
   check_done = check_pairs = false;
-  window_var = window_delta = window_samples = 0;
+  window_var = window_delta = window_samples = window_first = 0;
+}
+
+double bayes_sampler::stratified_factor(double power_var, double first) const {
+  const double s = params.fallback_stratified;
+  if (!params.stratified) return 1.0;
+  if (!params.path_traced || !(power_var > 0) || !std::isfinite(power_var) || !(s > 1)) return s;
+  const double helped = std::isfinite(first) ? std::min(power_var, std::max(first, 0.0)) : power_var;
+  const double left = power_var - (1 - 1 / s) * helped;
+  return left > 0 ? std::min(s, power_var / left) : s;
 }
 
 void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std::vector<double>& film, double weight,
@@ -520,32 +530,36 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     // Summed over the pass's samples with relMSE's weights 1 / (m^2 + 0.01), m the pixel's mean luminance with this
     // pass included (a pixel whose earlier samples missed a bright edge would otherwise weigh as black): V, the
     // learned estimator's variance, and V + D, power sampling's (D: the NEE events' second moments, see record).
-    double var = 0, delta = 0;
+    double var = 0, delta = 0, first = 0;
+    const bool firsts = px_first.size() == n;
     for (size_t i = 0; i < n; i++) {  // in pixel order
       vec3f m = {float(film[3 * i] / weight), float(film[3 * i + 1] / weight), float(film[3 * i + 2] / weight)};
       float y = luminance(m);
       double w = 1.0 / (double(y) * y + 0.01);
       var += w * px_var[i];
       delta += w * px_delta[i];
+      if (firsts) first += w * px_first[i];
     }
     window_var += var;
     window_delta += delta;
+    window_first += first;
     window_samples += double(n) * pass_spp;
   }
   if (window_samples >= params.fallback_window) {
     // A window is complete: its ratio votes.
     bool valid = window_var > 0 && std::isfinite(window_var) && std::isfinite(window_delta);
     check_ratio = valid ? (window_var + window_delta) / window_var : 0.0;
-    const double threshold = params.fallback_ratio * (params.stratified ? params.fallback_stratified : 1.0);
+    const double threshold = params.fallback_ratio * stratified_factor(window_var + window_delta, window_first);
     bool below = valid && window_var + window_delta < threshold * window_var;
     fallback_votes = below ? fallback_votes + 1 : 0;
-    window_var = window_delta = window_samples = 0;
+    window_var = window_delta = window_samples = window_first = 0;
     fallback = fallback_votes >= 2;
     if (fallback) fallback_spp = spp;
     check_done = valid && check_ratio >= 2 * threshold;
     if (fallback || check_done) {
       px_var = {};
       px_delta = {};
+      px_first = {};
       px_prev = {};
       px_cur = {};
       return;
@@ -553,6 +567,7 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
   }
   px_var.assign(n, 0.0);
   px_delta.assign(n, 0.0);
+  if (params.path_traced) px_first.assign(n, 0.0);
   if (pass_spp == 1 && px_prev.size() != n) px_prev.assign(n, NAN);
   if (pass_spp == 1 && px_cur.size() != n) px_cur.assign(n, NAN);
   if (pass_spp > 1) px_prev = {}, px_cur = {};

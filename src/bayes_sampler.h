@@ -40,6 +40,7 @@ struct bayes_sampler {
   bool fallback = false;
   int fallback_votes = 0;  // consecutive check windows whose ratio was below the threshold
   double window_var = 0, window_delta = 0, window_samples = 0;  // the current window's sums (see check_fallback)
+  double window_first = 0;  // ... and of power sampling's second moment at first vertices (path-traced renders)
   int fallback_spp = 0;    // spp rendered when it fell back (reports)
   bool check_done = false; // a window found learning to pay by at least twice the threshold: no more checks
   double check_ratio = 0;  // the last window's estimated relMSE ratio, power over learned (0: none yet)
@@ -47,6 +48,9 @@ struct bayes_sampler {
   // of their luminance's variance, and of its NEE events' second-moment change under power sampling. Each pixel is
   // written by the one task rendering its row (no races), and summed in pixel order.
   mutable std::vector<double> px_var, px_delta;  // (double: squares of radiance beyond float's range)
+  // Path-traced renders: per pixel, the sum over its first vertices' NEE events of their second moment under power
+  // sampling (what stratifying the first vertex can make smaller; empty in direct renders, where that is every event).
+  mutable std::vector<double> px_first;
   mutable std::vector<float> px_prev;  // passes of one spp: each pixel's sample luminance in the pass before (NaN: none)
   mutable std::vector<float> px_cur;   // ... and in the pass being rendered, which becomes px_prev once the pass is
                                        // complete (check_fallback): an interrupted pass leaves px_prev as it was
@@ -94,6 +98,12 @@ struct bayes_sampler {
   // The check's columns are sized for the film's pixels.
   void check_fallback(const std::vector<row_state>& rows, const std::vector<double>& film, double weight,
                       int pass_spp, int spp);
+  // The threshold's factor for a stratified first vertex, given a window's estimate of power sampling's variance
+  // (`power_var`, relMSE-weighted) and its first vertices' second moment (`first`). Direct renders: every NEE event is
+  // at the first vertex, and the factor is fallback_stratified s. Path-traced ones: stratification cuts only the first
+  // vertex's share, at most min(power_var, first) (a variance is at most its second moment), to 1 / s of itself; the
+  // factor is power_var over what is left, between 1 and s. 1 without stratification.
+  double stratified_factor(double power_var, double first) const;
   // Control variates (prepare set ctx.cv): the emission colour of cluster j (luminance 1), the colour-weighted sum
   // of every cluster's learned mean c_j, and c_J of one cluster in colour.
   vec3f cluster_color(const context& ctx, int j) const {

@@ -64,6 +64,8 @@ struct bayes_params {
                                    // helps a fixed choice more (the Cornell box, direct: estimated 1.86x, about 1.3x
                                    // measured against stratified power); 1 with --independent-samples
   bool stratified = true;          // set from the render (render_inputs::stratify)
+  bool path_traced = false;        // set from the render (max depth above 1): stratification then helps only the first
+                                   // vertex's share of power sampling's variance (bayes_sampler::stratified_factor)
   double fallback_window = 262144;  // samples (pixels x spp) a fallback check sums before it votes: the events that
                                     // make power sampling bad can be rare (points by a lamp's rim)
   int early_draws = 4;           // a direct render's NEE draws per camera sample in its first early_spp spp (render.cpp,

@@ -31,7 +31,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 19: bayes's staged pass weights (the first passes' film where learning paid)
 // 20: the sun's control-variate threshold apart from the lamps' (in the fingerprint)
 // 21: bayes's early draws (in the fingerprint)
-constexpr uint32_t version = 22;  // 22: Russian roulette's survival probability (path-traced images changed)
+// 22: Russian roulette's survival probability (path-traced images changed)
+constexpr uint32_t version = 23;  // 23: the fallback check's first-vertex sum (path-traced renders)
 
 }  // namespace
 
@@ -268,7 +269,7 @@ void write_sampler(writer& w, const light_sampler& ls) {
     w.value(int32_t(b->fallback_votes));
     w.value(int32_t(b->fallback_spp));
     w.value(b->check_ratio);
-    w.value(b->window_var), w.value(b->window_delta), w.value(b->window_samples);
+    w.value(b->window_var), w.value(b->window_delta), w.value(b->window_samples), w.value(b->window_first);
     w.value(uint8_t(b->check_pairs));
     w.value(uint8_t(b->check_done));
     w.value(uint64_t(b->px_var.size()));
@@ -314,17 +315,19 @@ void read_sampler(reader& r, light_sampler& ls, size_t pixels) {
     b->fallback_spp = r.value<int32_t>();
     b->check_ratio = r.value<double>();
     b->window_var = r.value<double>(), b->window_delta = r.value<double>(), b->window_samples = r.value<double>();
+    b->window_first = r.value<double>();
     b->check_pairs = r.value<uint8_t>() != 0;
     b->check_done = r.value<uint8_t>() != 0;
     uint64_t checked = r.value<uint64_t>();
     b->px_prev = r.column<float>();
     if (b->fallback_votes < 0 || b->fallback_spp < 0 || !std::isfinite(b->check_ratio) ||
         (checked != 0 && checked != pixels) || !(b->window_samples >= 0) || std::isnan(b->window_var) ||
-        std::isnan(b->window_delta) ||
+        std::isnan(b->window_delta) || std::isnan(b->window_first) ||
         (!b->px_prev.empty() && b->px_prev.size() != checked))
       r.fail("fallback check");
     b->px_var.assign(size_t(checked), 0.0);
     b->px_delta.assign(size_t(checked), 0.0);
+    if (b->params.path_traced) b->px_first.assign(size_t(checked), 0.0);
     b->px_cur.assign(b->px_prev.size(), NAN);
     // Prior means and coefficients are functions of the regions and statistics: recomputed (bit for bit the same);
     // then the saved weights replace the recomputed ones.

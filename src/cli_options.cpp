@@ -173,7 +173,8 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "Fall back to power sampling for the rest of the render when its estimated relMSE per sample is below "
                 "this many times the learned sampler's in two checked passes in a row (from 4 spp on): where learning "
                 "cannot pay for its own cost (default 1.5; doubled unless --independent-samples, as the estimate "
-                "assumes independent samples and stratification helps power sampling more; 0 = never)")
+                "assumes independent samples and stratification helps power sampling more: path traced, only as far "
+                "as the first vertex's share of the estimate goes; 0 = never)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-early-draws", o.bayes.early_draws,
                 "Direct illumination: NEE draws per camera sample (at least --light-samples) in the first "

@@ -334,7 +334,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       if constexpr (Sampler::learns) {
         if (std::isfinite(value) && std::isfinite(added) && std::isfinite(added_total)) {
           t0 = tm.start();
-          sink.record(nee_event<typename Sampler::context>{&ctx, choice, value, pixel, added, added_total});
+          sink.record(
+              nee_event<typename Sampler::context>{&ctx, choice, value, pixel, added, added_total, depth == 1});
           tm.stop(prof_record, t0);
         }
       }

@@ -71,7 +71,8 @@ struct light_choice {
 // One NEE event as a learning sampler sees it: its own context, the choice, and the sample's luminance
 // Y = f cos Le G V / (P(light | cluster) pdf) (zero when occluded or facing away); with the pixel and the luminance
 // of what the event added to the path's radiance (path throughput and MIS weight included): `added` by the light
-// sample alone, `added_total` with the control variate's terms.
+// sample alone, `added_total` with the control variate's terms; `first_vertex`: the event is the path's first
+// vertex's (the one a render stratifies).
 template <class Context>
 struct nee_event {
   const Context* context;
@@ -79,6 +80,7 @@ struct nee_event {
   float value;
   int pixel = 0;
   float added = 0, added_total = 0;
+  bool first_vertex = true;
 };
 
 }  // namespace bl
