@@ -377,11 +377,13 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   const int target = params.time_budget > 0 ? INT_MAX : params.spp;
   int done = result.spp;
   double seconds_per_spp = 0;  // of the last pass, with its learning (0: none yet)
+  int measured_draws = 0;      // ... whose NEE draws per vertex were these (0: unknown)
   if (!result.log.empty()) {  // (a resumed render: its checkpoint's last pass)
     const size_t n = result.log.size();
     const double t0 = n > 1 ? result.log[n - 2].seconds : 0.0;
     const int s0 = n > 1 ? result.log[n - 2].spp : 0;
     if (result.log[n - 1].spp > s0) seconds_per_spp = (result.log[n - 1].seconds - t0) / (result.log[n - 1].spp - s0);
+    measured_draws = pass_draws(sampler, params, s0, in.nee_samples);
   }
   progress.spp_done = done;
   for (int pass = result.passes; done < target; pass++) {
@@ -402,8 +404,12 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     // far, and a whole one started just before the budget ran a render up to a quarter past it. A cut pass is the
     // render's last: a --spp render of the same total cuts its last pass at the same place, and only there, so the
     // two stay the same image. (Where it ends before the budget, it goes on below with more of its samples.)
+    // (The first pass after bayes's early draws takes fewer draws, and less time per spp, than the pass timed.)
     const int scheduled = count;
-    if (params.time_budget > 0) count = fit_pass_to_time(count, params.time_budget - result.seconds, seconds_per_spp);
+    const int draws = pass_draws(sampler, params, done, in.nee_samples);
+    if (params.time_budget > 0)
+      count = fit_pass_to_time(count, params.time_budget - result.seconds,
+                               seconds_per_spp_at(seconds_per_spp, measured_draws, draws));
     const double cycle_start = result.seconds;
     progress.pass = pass + 1;
     // The bar's running pass (or piece of one): its spp and rows, timed from now.
@@ -421,7 +427,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     render_inputs pin = in;
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
-    pin.nee_samples = pass_draws(sampler, params, done, in.nee_samples);
+    pin.nee_samples = draws;
     if (auto_points) {
       choose_tile_points(result.point_stats, done, pass, pin.nee_samples, tile_points);
       pin.point_tiles = tile_points.data();
@@ -512,6 +518,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     result.seconds += seconds_since(t0);
     // (Not the checkpoint after it: a cut pass, the last, has none.)
     seconds_per_spp = (result.seconds - cycle_start) / count;
+    measured_draws = draws;
     done += count;
     result.spp = done;
     result.passes = pass + 1;
@@ -560,6 +567,11 @@ bool ends_scheduled_pass(int spp, int64_t pixels) {
   int64_t done = 0;
   for (int pass = 0; done < spp; pass++) done += pass_size(pass, int(done), pixels);
   return done == spp;
+}
+
+double seconds_per_spp_at(double seconds_per_spp, int measured_draws, int draws) {
+  if (measured_draws <= 0 || draws <= 0 || measured_draws == draws) return seconds_per_spp;
+  return seconds_per_spp * (2.0 + draws) / (2.0 + measured_draws);
 }
 
 int fit_pass_to_time(int count, double left, double seconds_per_spp) {

@@ -223,6 +223,23 @@ TEST_CASE("passes of a tiny image grow to 65536 samples, so their records stay f
   CHECK(r.passes < 80);  // about 67 (16,400 in 64-spp passes)
 }
 
+TEST_CASE("a --time render sizes its last pass from the last pass's speed, scaled to its NEE draws", "[passes]") {
+  // A quarter more than fits, rounded up; the scheduled size where it fits or no speed is known.
+  CHECK(fit_pass_to_time(8, 1.0, 0.5) == 3);   // ceil(1.25 * 2)
+  CHECK(fit_pass_to_time(8, 10.0, 0.5) == 8);
+  CHECK(fit_pass_to_time(8, 1.0, 0.0) == 8);
+  CHECK(fit_pass_to_time(8, 0.01, 0.5) == 1);
+  // After bayes's early draws (4 per camera sample) a pass of one draw takes about half the time per spp: timed by
+  // the 4-draw pass, a budget that ended inside the next pass cut it to 0.6 of what fitted (a review: the render
+  // stopped 1-3 spp early).
+  CHECK(seconds_per_spp_at(0.06, 4, 1) == Approx(0.03));
+  CHECK(seconds_per_spp_at(0.03, 1, 4) == Approx(0.06));
+  CHECK(seconds_per_spp_at(0.06, 4, 4) == 0.06);
+  CHECK(seconds_per_spp_at(0.06, 0, 1) == 0.06);  // draws of the timed pass unknown
+  CHECK(fit_pass_to_time(4, 0.11, seconds_per_spp_at(0.056, 4, 1)) == 4);  // the living room's switch: all 4 fit
+  CHECK(fit_pass_to_time(4, 0.11, 0.056) == 3);
+}
+
 TEST_CASE("time spent between passes (checkpoints) counts in the render's seconds and its time budget", "[passes]") {
   // A 4096^2 render's checkpoints took 30 s of a 42 s run whose summary and log said 9.1 s, and a --time budget
   // ignored them (a review). Each call between passes here takes at least 50 ms (a sleep: a lower bound, not a timing).
