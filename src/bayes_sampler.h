@@ -55,6 +55,10 @@ struct bayes_sampler {
   mutable std::vector<float> px_cur;   // ... and in the pass being rendered, which becomes px_prev once the pass is
                                        // complete (check_fallback): an interrupted pass leaves px_prev as it was
   bool check_pairs = false;            // the last pass had one spp: px_prev holds its samples
+  // Before a pass whose NEE draws differ from the last pass's: half the squared difference of a pixel's samples in the
+  // two passes would mix their variances (a 4-draw sample's beside a 1-draw one's underestimates the latter), so a
+  // pass of one spp is then not checked (its samples still pair with the next pass's).
+  void unpair() { check_pairs = false; }
   void flush_check(const row_state& row) const;
   // Forgets the check's state (a new frame: its film starts empty); the fallback itself stays.
   void restart_check();

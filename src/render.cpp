@@ -428,6 +428,8 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
     pin.nee_samples = draws;
+    if constexpr (std::is_same_v<Sampler, bayes_sampler>)
+      if (measured_draws > 0 && draws != measured_draws) sampler.unpair();
     if (auto_points) {
       choose_tile_points(result.point_stats, done, pass, pin.nee_samples, tile_points);
       pin.point_tiles = tile_points.data();
