@@ -150,7 +150,7 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
   // its clusters, each as a cluster of its own.
   size_t base = size_t(ctx.pair_base);
   const bool gloss = params.bsdf_factor && sp.gloss_peak > 0;
-  ctx.cv = params.control_variate && sp.last && !gloss && cv_allowed;
+  ctx.cv = params.control_variate && (sp.last || params.cv_every_vertex) && !gloss && cv_allowed;
   if (gloss && ctx.pair_count != ctx.count && ctx.pair_count <= max_cut_entries) {
     // A glossy point weighs every member as its own cluster (with its own lobe factor): which lights a highlight
     // mirrors changes faster across a region than the members' region-wide weights can follow.
@@ -361,6 +361,19 @@ light_choice bayes_sampler::sample_members(const context& ctx, double u, double 
   double inner = 1;
   int leaf = sample_by_intensity(*tree, node, place_in_cell(u, lo, p, u_inner), inner);
   return {tree->light[size_t(leaf)], float(p * inner), m, float(inner), p};
+}
+
+bool bayes_sampler::cv_covers_light(const context& ctx, int light) const {
+  if (!ctx.cv || ctx.count == 0) return false;
+  // (The entry holding the light as pmf finds it: the sun is the last cluster and member.)
+  if (light == lights->sun)
+    return ctx.nodes[ctx.count - 1] == sun_cluster &&
+           cv_covers(ctx, ctx.pair_count == ctx.count ? ctx.count - 1 : ctx.pair_count - 1);
+  int leaf = tree->leaf_of_light[size_t(light)];
+  if (ctx.pair_count == ctx.count)
+    return cv_covers(ctx, holding_entry(*tree, leaf, ctx.nodes, ctx.nodes + ctx.tree_count));
+  return cv_covers(ctx, holding_entry(*tree, leaf, ctx.members,
+                                      ctx.members + ctx.pair_count - (ctx.tree_count < ctx.count ? 1 : 0)));
 }
 
 float bayes_sampler::members_pmf(const context& ctx, int light) const {

@@ -120,6 +120,14 @@ struct bayes_sampler {
     if (ctx.pair_count == ctx.count) return cluster_color(ctx, m) * ctx.cvg[m];
     return cluster_color(ctx, m) * (stats.cv[size_t(ctx.pair_base + m)] * ctx.gfac[group_of(ctx, m)]);
   }
+  // Whether member m has a control variate at the point (ctx.cv and a learned mean c_m != 0): NEE of its lights is
+  // then unweighted at any vertex, and BSDF-sampled hits on them weigh 0 (cv_covers_light).
+  bool cv_covers(const context& ctx, int m) const {
+    if (!ctx.cv || m < 0) return false;
+    return ctx.pair_count == ctx.count ? ctx.cvg[m] != 0
+                                       : stats.cv[size_t(ctx.pair_base + m)] * ctx.gfac[group_of(ctx, m)] != 0;
+  }
+  bool cv_covers_light(const context& ctx, int light) const;
   void learn(std::vector<row_state>& rows);
   // Sizes the statistics for every region and sets the region-level prior means of the pairs of regions
   // [first_region, end) (a function of each region's box and cut only). Weights are refolded by the caller.

@@ -452,12 +452,15 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
     if (!b.region_prior || !b.second_moment || !b.control_variate)
       b.cv_min_visible = d.cv_min_visible, b.cv_sun_min_visible = d.cv_sun_min_visible;
     if (!b.second_moment) b.control_variate = d.control_variate;
+    if (!b.region_prior || !b.second_moment || !b.control_variate || p.max_depth == 1)
+      b.cv_every_vertex = d.cv_every_vertex;
     if (!b.prior || !b.region_prior || !(b.hierarchy > 0)) b.mean_hierarchy = d.mean_hierarchy;
     h.value(b.a0), h.value(b.b0), h.value(b.kappa0), h.value(b.alpha0), h.value(b.c), h.value(b.epsilon);
     h.value(b.second_moment), h.value(b.distance_regression), h.value(b.prior), h.value(b.hierarchy);
     h.value(b.region_prior), h.value(b.control_variate), h.value(b.cv_min_visible), h.value(b.cv_sun_min_visible);
     h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
     h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
+    h.value(b.cv_every_vertex);
     // The early draws, where they can apply (direct illumination; one draw or no early spp: none).
     const bool early = p.max_depth == 1 && b.early_draws > std::max(1, p.light_samples) && b.early_spp > 0;
     h.value(early ? b.early_draws : 0), h.value(early ? b.early_spp : 0);

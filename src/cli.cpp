@@ -88,14 +88,16 @@ std::string unused_because(const std::string& name, const std::string& group, sa
     if (naive && (name == "--bayes-a0" || name == "--bayes-b0" || name == "--bayes-kappa0" ||
                   name == "--bayes-alpha0" || name == "--bayes-c" || name == "--bayes-no-mean-hierarchy"))
       return "no prior with --bayes-naive";
+    const bool cv_option = name == "--bayes-cv-min-visible" || name == "--bayes-cv-sun-min-visible" ||
+                           name == "--bayes-cv-last-only";
     if (point && (name == "--bayes-no-orientation" || name == "--bayes-no-bsdf-factor" || name == "--bayes-no-cv" ||
+                  name == "--bayes-cv-last-only" ||
                   name == "--bayes-cv-min-visible" || name == "--bayes-cv-sun-min-visible" ||
                   name == "--bayes-no-mean-hierarchy"))
       return "region prior only, not with --bayes-prior point";
-    const bool cv_threshold = name == "--bayes-cv-min-visible" || name == "--bayes-cv-sun-min-visible";
-    if (mean && (name == "--bayes-no-cv" || cv_threshold))
+    if (mean && (name == "--bayes-no-cv" || cv_option))
       return "control variates need --bayes-pmf second-moment";
-    if (!o.bayes.control_variate && cv_threshold) return "no control variates with --bayes-no-cv";
+    if (!o.bayes.control_variate && cv_option) return "no control variates with --bayes-no-cv";
     if (!(o.bayes.hierarchy > 0) && name == "--bayes-no-mean-hierarchy") return "no hierarchy with --bayes-hierarchy 0";
     return "";
   }
@@ -255,6 +257,11 @@ void warn_after_scene(const render_options& o, const render_params& params, cons
                    "illumination only, and the max depth is %d)\n",
                    early.c_str(), max_depth);
   } else if (bayes) {
+    if (given("--bayes-cv-last-only") &&
+        unused_because("--bayes-cv-last-only", bayes_group, sampler_kind::bayes, o).empty())
+      std::fprintf(stderr,
+                   "bayeslight: warning: options that change nothing in this run are ignored: --bayes-cv-last-only "
+                   "(at max depth 1 every vertex is the last)\n");
     const int per_sample = std::max(1, o.light_samples);
     const bayes_params defaults;
     auto takes_effect = [&](int draws, int spp) { return draws > per_sample && spp > 0; };

@@ -120,7 +120,11 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "(ablation: prior mean from the bound at every shading point)")
       ->check(CLI::IsMember({"region", "point"}))->group(bg);
   r->add_flag_callback("--bayes-no-cv", [&o] { o.bayes.control_variate = false; },
-                       "Ablation: no control variates (with the region prior they apply where NEE is unweighted)")->group(bg);
+                       "Ablation: no control variates (with the region prior they apply at diffuse points: NEE of a "
+                       "light they cover is unweighted, no MIS with BSDF sampling)")->group(bg);
+  r->add_flag_callback("--bayes-cv-last-only", [&o] { o.bayes.cv_every_vertex = false; },
+                       "Ablation: control variates only where NEE is unweighted anyway (direct illumination, a path's "
+                       "last vertex), MIS for every light at the other vertices (the rule before 0.56)")->group(bg);
   r->add_option("--bayes-cv-min-visible", o.bayes.cv_min_visible,
                 "Control variates only for lamp clusters a region sees with probability at least this (default 0: "
                 "any) and that have samples there or in its coarse region (their mean is capped by those samples' "

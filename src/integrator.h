@@ -2,8 +2,10 @@
 // BSDF continuation with MIS (power heuristic), Russian roulette from the third bounce (roulette_scale).
 // Invariants: max_depth D counts bounces: NEE runs at vertices 1..D; at vertex D it is unweighted and the
 // path ends (D = 1 is pure light sampling, the paper's direct-only mode); emission reached by BSDF sampling
-// from vertex k < D is MIS-weighted against NEE at k using the sampler's pmf at k. All randomness comes
-// from draw_vertex(key, vertex) in the dimension table of rng.h. Never returns a non-finite value.
+// from vertex k < D is MIS-weighted against NEE at k using the sampler's pmf at k, except a light that a control
+// variate covers at k (bayes): NEE takes it alone, unweighted, and its BSDF-sampled hit weighs 0 (both strategies'
+// weights still sum to 1 for every light and direction). All randomness comes from draw_vertex(key, vertex) in the
+// dimension table of rng.h. Never returns a non-finite value.
 #pragma once
 
 #include "bvh.h"
@@ -27,6 +29,14 @@ template <class S, class = void>
 struct has_control_variates : std::false_type {};
 template <class S>
 struct has_control_variates<S, std::void_t<decltype(&S::cv_total)>> : std::true_type {};
+
+// Whether the previous vertex's NEE took `light` unweighted under a control variate (its BSDF-sampled hit then
+// weighs 0).
+template <class S>
+bool covered_by_cv(const S& sampler, const typename S::context& ctx, int light) {
+  if constexpr (has_control_variates<S>::value) return sampler.cv_covers_light(ctx, light);
+  else return false;
+}
 
 // The read-only inputs of path sampling.
 struct render_inputs {
@@ -197,7 +207,9 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     if (h.tri == invalid_id) {
       if (in_sun_disk(lights, dir)) {
         float w = 1;
-        if (prev_mis)
+        if (prev_mis && covered_by_cv(sampler, ctxs[(depth - 1) & 1], lights.sun))
+          w = 0;
+        else if (prev_mis)
           w = power_heuristic(prev_bsdf_pdf, prev_nee_points * sampler.pmf(ctxs[(depth - 1) & 1], lights.sun) *
                                                  cone_pdf(lights.sun_one_minus_cos));
         radiance += beta * lights.sun_radiance * w;
@@ -211,7 +223,9 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       vec3f le = emitted_radiance(lights, hit_light, sp.front);
       if (!is_black(le)) {
         float w = 1;
-        if (prev_mis) {
+        if (prev_mis && covered_by_cv(sampler, ctxs[(depth - 1) & 1], hit_light)) {
+          w = 0;
+        } else if (prev_mis) {
           float cos_l = std::fabs(dot(scene.tri_ng[h.tri], dir));
           float light_pdf = prev_nee_points * sampler.pmf(ctxs[(depth - 1) & 1], hit_light) *
                             triangle_light_pdf(scene, lights, hit_light, org, h.t, cos_l);
@@ -276,6 +290,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
                                            rk->u53(dim_light_inner, dim_light_inner_lo));
       tm.stop(prof_select, t0);
       if (!(choice.light != invalid_id && choice.prob > 0)) continue;
+      bool cv_light = false;
+      if constexpr (has_control_variates<Sampler>::value) cv_light = sampler.cv_covers(ctx, choice.cluster);
       st.nee_samples++;
       if (depth == 1) st.first_draws++, st.first_points += uint64_t(points);
       float value = 0, added = 0, added_total = 0;
@@ -297,7 +313,9 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
         if (!visible) continue;
         seen = true;
         vec3f unweighted = fc * ls.le / ls.pdf;
-        float w = last ? 1.0f : power_heuristic(nee_points * choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
+        // Unweighted at the last vertex, and for a light a control variate covers (its BSDF-sampled hits weigh 0).
+        float w = last || cv_light ? 1.0f
+                                   : power_heuristic(nee_points * choice.prob * ls.pdf, bsdf_pdf(bsdf, wo, ls.wi));
         vec3f one = beta * unweighted * (w * inv_n / choice.prob);
         unweighted_sum += unweighted;
         add_sum += one;
@@ -317,9 +335,10 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
         added = added_total = luminance(add_sum);
       }
       if constexpr (has_control_variates<Sampler>::value) {
-        // Control variate (unweighted NEE only): sum_j c_j + (Y_J - c_J) / P_J, the Y_J / P_J part added above;
-        // c_j in colour is the cluster's learned albedo-free mean times (kd + ks) / pi. (Over nee_samples draws the
-        // sum is added once: each draw adds its share.)
+        // Control variate: sum_j c_j + (Y_J - c_J) / P_J, the Y_J / P_J part added above (unweighted where c_J != 0;
+        // a cluster without one has c_J = 0 and keeps its MIS weight); c_j in colour is the cluster's learned
+        // albedo-free mean times (kd + ks) / pi. (Over nee_samples draws the sum is added once: each draw adds its
+        // share.)
         if (ctx.cv) {
           vec3f c = sampler.cv_total(ctx) - sampler.cv_cluster(ctx, choice.cluster) * float(1 / choice.cluster_prob);
           vec3f add = beta * (bsdf.kd + bsdf.ks) * inv_pi_f * c * inv_n;

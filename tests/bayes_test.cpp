@@ -172,7 +172,9 @@ shade_point pixel_point(const test_scene& t, int x, int y) {
 
 // A bayes sampler over make_scene(3, sun) whose cuts are the 3 lamps (3 clusters, not a shared cut of 6 leaves,
 // and not refined into members: each cluster is one pair, whose posterior the tests below follow), then the sun if
-// `sun`, with bayes parameters `bp`, and a context prepared at pixel (4, 4) whose cut is those clusters.
+// `sun`, with bayes parameters `bp`, and a context prepared at pixel (4, 4) whose cut is those clusters. The point is a
+// path's first vertex, not its last: its NEE is MIS-weighted and, unless bp.cv_every_vertex (the default rule; the
+// control-variate tests set it), has no control variates, so that the learning tests check the plain pmf.
 struct three_lamps {
   std::unique_ptr<test_scene> t;
   std::optional<light_sampler> ls;
@@ -180,7 +182,7 @@ struct three_lamps {
   std::unique_ptr<cut_context> ctx;
   bayes_sampler& sampler() { return std::get<bayes_sampler>(*ls); }
 };
-three_lamps make_three_lamps(const bayes_params& bp, bool sun = false) {
+three_lamps make_three_lamps(const bayes_params& bp, bool sun = false, bool cv_every_vertex = false) {
   three_lamps f;
   f.t = make_scene(3, sun);
   sampler_params sp;
@@ -188,6 +190,7 @@ three_lamps make_three_lamps(const bayes_params& bp, bool sun = false) {
   sp.regions.shared_cut_lights = 0;
   sp.regions.max_members = 0;
   sp.bayes = bp;
+  sp.bayes.cv_every_vertex = cv_every_vertex;
   f.ls.emplace(make_light_sampler(sp, f.t->in, f.t->tree));
   f.pt = pixel_point(*f.t, 4, 4);
   f.ctx = std::make_unique<cut_context>();
@@ -991,65 +994,70 @@ TEST_CASE("under the mean hierarchy a fine pair's prior mean is the lower of its
   }
 }
 
-TEST_CASE("control variates apply at unweighted NEE to clusters visible at least the threshold", "[bayes]") {
+TEST_CASE("control variates apply at every vertex to clusters visible at least the threshold", "[bayes]") {
   // With a lamp threshold of 0.96: cluster 0 is always visible with a steady contribution, cluster 1 is visible half
-  // the time, cluster 2 has no data. Where NEE is unweighted (sp.last) cluster 0 gets the control variate
-  // c = E[1 - p0] k g and the pmf the residual's weight sqrt(E[1 - p0] h + E[1 - p0] E[p0] k^2) g; clusters 1 and 2
-  // (E[1 - p0] < cv_min_visible) keep the plain weight and c = 0. Elsewhere (MIS-weighted NEE) nothing changes.
-  bayes_params bp;
-  bp.cv_min_visible = 0.96;
-  three_lamps f = make_three_lamps(bp);
-  REQUIRE(f.sampler().params.control_variate);
-  auto& t = f.t;
-  bayes_sampler& s = f.sampler();
-  shade_point pt = f.pt;
-  auto& ctx = f.ctx;
-  pcg32 rng(61, 8);
-  std::vector<bayes_row> rows(1);
-  for (int i = 0; i < 4000; i++) {
-    for (int j = 0; j < 2; j++) {
-      light_choice c;
-      c.cluster = j;
-      float y = j == 0 ? float(0.3 * (1 + 0.05 * normal(rng))) : (unif64(rng) < 0.5 ? 0.0f : 0.2f);
-      s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
-    }
-  }
-  s.learn(rows);
-  for (bool last : {false, true}) {
-    INFO("last vertex " << last);
-    shade_point q = pt;
-    q.last = last;
-    *ctx = cut_context{};
-    s.prepare(*ctx, q);
-    CHECK(ctx->cv == last);
-    double w[3], sum = 0;
-    vec3f cv_sum = {0, 0, 0};
-    for (int j = 0; j < 3; j++) {
-      size_t i = size_t(ctx->pair_base + j);
-      // g: the point factor, 1 / d^2 times the orientation factor.
-      double d = cluster_distance(t->tree, ctx->nodes[j], pt.p);
-      double g = orientation_of(*t, s, ctx->nodes[j], pt.p, pt.n) / (d * d);
-      double p1 = pair_p1(s.stats, i, s.regions.pair_parent[i], s.params), k = 0, h = 0;
-      bool learned = pair_posterior(s.stats, i, s.params, s.stats.mu0[i], k, h);
-      bool cv = last && j == 0;
-      CHECK((p1 >= s.params.cv_min_visible) == (j == 0));
-      if (cv) {
-        REQUIRE(learned);
-        CHECK(double(s.stats.cv[i]) == Approx(p1 * k).epsilon(1e-6));
-        CHECK(double(ctx->cvg[j]) == Approx(p1 * k * g).epsilon(1e-5));
-        w[j] = std::sqrt(p1 * h + p1 * (1 - p1) * k * k) * g;
-        CHECK(w[j] < 0.2 * double(s.stats.w[i]) * g);  // decisive: the residual is far smaller than the signal
-      } else {
-        w[j] = double(s.stats.w[i]) * g;
-        if (last) CHECK(ctx->cvg[j] == 0);
+  // the time, cluster 2 has no data. Cluster 0 gets the control variate c = E[1 - p0] k g and the pmf the residual's
+  // weight sqrt(E[1 - p0] h + E[1 - p0] E[p0] k^2) g; clusters 1 and 2 (E[1 - p0] < cv_min_visible) keep the plain
+  // weight and c = 0. At every vertex (the default), or with --bayes-cv-last-only only where NEE is unweighted
+  // anyway (sp.last); elsewhere nothing changes then.
+  for (bool every : {true, false}) {
+    INFO("control variates at every vertex " << every);
+    bayes_params bp;
+    bp.cv_min_visible = 0.96;
+    three_lamps f = make_three_lamps(bp, false, every);
+    REQUIRE(f.sampler().params.control_variate);
+    auto& t = f.t;
+    bayes_sampler& s = f.sampler();
+    shade_point pt = f.pt;
+    auto& ctx = f.ctx;
+    pcg32 rng(61, 8);
+    std::vector<bayes_row> rows(1);
+    for (int i = 0; i < 4000; i++) {
+      for (int j = 0; j < 2; j++) {
+        light_choice c;
+        c.cluster = j;
+        float y = j == 0 ? float(0.3 * (1 + 0.05 * normal(rng))) : (unif64(rng) < 0.5 ? 0.0f : 0.2f);
+        s.record(rows[0], nee_event<cut_context>{ctx.get(), c, y});
       }
-      if (last) cv_sum += s.cluster_color(*ctx, j) * ctx->cvg[j];
-      sum += w[j];
     }
-    for (int j = 0; j < 3; j++) CHECK(cluster_pmf(*ctx, j) == Approx(w[j] / sum).epsilon(1e-5).margin(3e-7));
-    if (last) {
-      CHECK(s.cv_total(*ctx).x == Approx(cv_sum.x));
-      CHECK(s.cv_total(*ctx).y == Approx(cv_sum.y));
+    s.learn(rows);
+    for (bool last : {false, true}) {
+      INFO("last vertex " << last);
+      shade_point q = pt;
+      q.last = last;
+      *ctx = cut_context{};
+      s.prepare(*ctx, q);
+      const bool on = last || every;
+      CHECK(ctx->cv == on);
+      double w[3], sum = 0;
+      vec3f cv_sum = {0, 0, 0};
+      for (int j = 0; j < 3; j++) {
+        size_t i = size_t(ctx->pair_base + j);
+        // g: the point factor, 1 / d^2 times the orientation factor.
+        double d = cluster_distance(t->tree, ctx->nodes[j], pt.p);
+        double g = orientation_of(*t, s, ctx->nodes[j], pt.p, pt.n) / (d * d);
+        double p1 = pair_p1(s.stats, i, s.regions.pair_parent[i], s.params), k = 0, h = 0;
+        bool learned = pair_posterior(s.stats, i, s.params, s.stats.mu0[i], k, h);
+        bool cv = on && j == 0;
+        CHECK((p1 >= s.params.cv_min_visible) == (j == 0));
+        if (cv) {
+          REQUIRE(learned);
+          CHECK(double(s.stats.cv[i]) == Approx(p1 * k).epsilon(1e-6));
+          CHECK(double(ctx->cvg[j]) == Approx(p1 * k * g).epsilon(1e-5));
+          w[j] = std::sqrt(p1 * h + p1 * (1 - p1) * k * k) * g;
+          CHECK(w[j] < 0.2 * double(s.stats.w[i]) * g);  // decisive: the residual is far smaller than the signal
+        } else {
+          w[j] = double(s.stats.w[i]) * g;
+          if (on) CHECK(ctx->cvg[j] == 0);
+        }
+        if (on) cv_sum += s.cluster_color(*ctx, j) * ctx->cvg[j];
+        sum += w[j];
+      }
+      for (int j = 0; j < 3; j++) CHECK(cluster_pmf(*ctx, j) == Approx(w[j] / sum).epsilon(1e-5).margin(3e-7));
+      if (on) {
+        CHECK(s.cv_total(*ctx).x == Approx(cv_sum.x));
+        CHECK(s.cv_total(*ctx).y == Approx(cv_sum.y));
+      }
     }
   }
 }
