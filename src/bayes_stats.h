@@ -75,9 +75,10 @@ struct bayes_params {
                                  // hits weigh 0). Path traced, 32 spp, seeds 12 / 13: relMSE 0.88 / 0.89x of the last
                                  // vertex's alone in the plant room, 0.87 / 0.86x living room, 0.76 / 0.79x hall
   bool control_variate = true;   // region prior only: at a diffuse point (at every path vertex with cv_every_vertex,
-                                 // else where NEE is unweighted anyway), add the learned mean c_j = E[1 - p0] k_j / d^2 of every cluster and
-                                 // estimate the residual (Y_J - c_J) / P_J, with P_j proportional to the root of the
-                                 // residual's second moment E[1 - p0] h + E[1 - p0] E[p0] k^2 (METHOD.md 5)
+                                 // else where NEE is unweighted anyway), add the learned mean c_j = E[1 - p0] k_j / d^2
+                                 // of every cluster and estimate the residual (Y_J - c_J) / P_J, with P_j
+                                 // proportional to the root of the residual's second moment
+                                 // E[1 - p0] h + E[1 - p0] E[p0] k^2 (METHOD.md 5)
 };
 
 // Statistics columns, one entry per (region, cluster) pair, with the posterior folded into per-pair

@@ -52,7 +52,7 @@ struct shade_point {
   float albedo = 0;  // luminance of the BSDF's albedos (kd + ks), scale of the expected contribution
   int pixel = 0;     // image pixel of the path
   int depth = 1;     // 1 = first hit
-  bool last = false; // the path ends here: NEE is unweighted (no MIS); --bayes-cv-last-only applies control variates only here
+  bool last = false; // the path ends here: NEE is unweighted (no MIS; --bayes-cv-last-only: control variates here only)
   // A glossy point (Phong lobe; bayes's point factor): wo mirrored about the shading normal, the exponent, and the
   // BSDF over the albedo scale (kd + ks) / pi as gloss_base + gloss_peak cos^ns, cos toward refl (gloss_peak 0: none).
   vec3f refl = {0, 0, 1};
