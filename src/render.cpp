@@ -428,8 +428,10 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     pin.stratum_base = uint64_t(result.stratum_base);
     pin.stratum_key = stratum_key_of(in.seed, pin.stratum_base);
     pin.nee_samples = draws;
+    // (Not after a fallback, which ends the checks: a resumed render, which cannot tell the draws of the pass before
+    // its checkpoint from the sampler's state after it, keeps the same check state then.)
     if constexpr (std::is_same_v<Sampler, bayes_sampler>)
-      if (measured_draws > 0 && draws != measured_draws) sampler.unpair();
+      if (measured_draws > 0 && draws != measured_draws && !sampler.fallback) sampler.unpair();
     if (auto_points) {
       choose_tile_points(result.point_stats, done, pass, pin.nee_samples, tile_points);
       pin.point_tiles = tile_points.data();
