@@ -1096,6 +1096,9 @@ TEST_CASE("bayes options that its other options leave without effect are named i
            // (each alone changes nothing; dropping both would turn the early draws back on: not "ignored")
            {"--max-depth 1 --bayes-early-draws 1 --bayes-early-spp 0",
             "--bayes-early-draws 1 and --bayes-early-spp 0 each turn the early draws off: one of them is enough"},
+           {"--max-depth 1 --bayes-cv-last-only", "ignored: --bayes-cv-last-only (at max depth 1 every vertex is the last)"},
+           {"--max-depth 3 --bayes-no-cv --bayes-cv-last-only",
+            "--bayes-cv-last-only (no control variates with --bayes-no-cv)"},
        }) {
     auto r = run_bayeslight(base + " " + p.options);
     INFO(p.options << "\n" << r.output);
@@ -1114,7 +1117,8 @@ TEST_CASE("bayes options that its other options leave without effect are named i
                               "--max-depth 1 --bayes-early-draws 1", "--max-depth 1 --bayes-early-spp 0",
                               "--max-depth 1 --light-samples 2 --bayes-early-draws 2",
                               // more draws than --light-samples, where the default's are not
-                              "--max-depth 1 --light-samples 4 --bayes-early-draws 6 --bayes-early-spp 2"}) {
+                              "--max-depth 1 --light-samples 4 --bayes-early-draws 6 --bayes-early-spp 2",
+                              "--max-depth 3 --bayes-cv-last-only"}) {
     auto r = run_bayeslight(base + " " + options);
     INFO(options << "\n" << r.output);
     CHECK(r.status == 0);
