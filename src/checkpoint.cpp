@@ -32,7 +32,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 20: the sun's control-variate threshold apart from the lamps' (in the fingerprint)
 // 21: bayes's early draws (in the fingerprint)
 // 22: Russian roulette's survival probability (path-traced images changed)
-constexpr uint32_t version = 23;  // 23: the fallback check's first-vertex sum (path-traced renders)
+// 23: the fallback check's first-vertex sum (path-traced renders)
+constexpr uint32_t version = 24;  // 24: passes after bayes's fallback weigh as the first one after it
 
 }  // namespace
 
@@ -708,13 +709,16 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   // the first passes were kept apart), summed as the render sums them.
   const bool staged = std::holds_alternative<bayes_sampler>(sampler) && stages_passes(params, weighting);
   if (result.late_learns && !(staged && result.spp >= staged_spp)) r.fail("staged pass weights");
+  // A pass weighs as the first of its stratified light set (render.cpp): every pass before the set now running
+  // started one of its own (the model changed after each), and every later one belongs to it.
   double weight = 0, early = 0, late_ref = 0;
   spp = 0;
   for (const pass_record& p : result.log) {
-    const double wk = staged ? staged_pass_weight(spp, weighting, result.late_learns) : pass_weight(spp, weighting);
+    const int set = std::min(spp, result.stratum_base);
+    const double wk = staged ? staged_pass_weight(set, weighting, result.late_learns) : pass_weight(set, weighting);
     weight += wk * (p.spp - spp);
     if (result.late_learns && spp < staged_spp) early = weight;
-    if (result.late_learns && spp >= staged_spp) late_ref += pass_weight(spp, weighting) * (p.spp - spp);
+    if (result.late_learns && spp >= staged_spp) late_ref += pass_weight(set, weighting) * (p.spp - spp);
     spp = p.spp;
   }
   if (result.film_weight != weight) r.fail("film weight");
