@@ -44,6 +44,17 @@ render_params small_params(sampler_kind kind, int spp, double weighting, uint64_
   return p;
 }
 
+// A weighted render's film against the sums expected from unweighted ones: equal up to rounding.
+void check_film_matches(const std::vector<double>& film, const std::vector<double>& expect) {
+  double worst = 0, scale = 0;
+  for (size_t i = 0; i < expect.size(); i++) {
+    worst = std::max(worst, std::fabs(film[i] - expect[i]));
+    scale = std::max(scale, std::fabs(expect[i]));
+  }
+  REQUIRE(scale > 0);
+  CHECK(worst <= 1e-9 * scale);
+}
+
 double squared_error(const image_data& a, const image_data& ref) {
   double e = 0;
   for (size_t i = 0; i < a.pixels.size(); i++) e += std::pow(double(a.pixels[i]) - ref.pixels[i], 2);
@@ -181,13 +192,7 @@ TEST_CASE("an adaptive sampler's film is each pass's sums times the pass's fixed
     }
     CHECK(w.film_weight == Approx(weight).epsilon(1e-12));
     CHECK(w.film_weight < 15);
-    double worst = 0, scale = 0;
-    for (size_t i = 0; i < expect.size(); i++) {
-      worst = std::max(worst, std::fabs(w.film[i] - expect[i]));
-      scale = std::max(scale, std::fabs(expect[i]));
-    }
-    REQUIRE(scale > 0);
-    CHECK(worst <= 1e-9 * scale);
+    check_film_matches(w.film, expect);
   }
 }
 
@@ -230,13 +235,7 @@ TEST_CASE("after bayes falls back, every later pass weighs as the first one afte
   }
   CHECK(w.film_weight == Approx(weight).epsilon(1e-12));
   CHECK(w.film_weight < growing);  // (the old rule's weights grew after the fallback too)
-  double worst = 0, scale = 0;
-  for (size_t i = 0; i < expect.size(); i++) {
-    worst = std::max(worst, std::fabs(w.film[i] - expect[i]));
-    scale = std::max(scale, std::fabs(expect[i]));
-  }
-  REQUIRE(scale > 0);
-  CHECK(worst <= 1e-9 * scale);
+  check_film_matches(w.film, expect);
 }
 
 TEST_CASE("non-adaptive and frozen samplers keep equal weights bit for bit", "[passes]") {
