@@ -33,7 +33,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 21: bayes's early draws (in the fingerprint)
 // 22: Russian roulette's survival probability (path-traced images changed)
 // 23: the fallback check's first-vertex sum (path-traced renders)
-constexpr uint32_t version = 24;  // 24: passes after bayes's fallback weigh as the first one after it
+// 24: passes after bayes's fallback weigh as the first one after it
+constexpr uint32_t version = 25;  // 25: ... with the share of the plain schedule (the passes before it kept apart)
 
 }  // namespace
 
@@ -568,8 +569,8 @@ static void emit_checkpoint(writer& w, const render_fingerprint_data& fingerprin
   }
   w.column(result.film);
   w.value(result.film_weight);
-  w.value(uint8_t(result.late_learns));
-  if (result.late_learns) {
+  w.value(uint8_t(result.late_learns)), w.value(uint8_t(result.late_fallback));
+  if (result.late_learns || result.late_fallback) {
     w.column(result.early_film);
     w.value(result.early_weight), w.value(result.late_ref_weight);
   }
@@ -674,7 +675,8 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   result.film = r.column<double>(size_t(w) * size_t(hgt) * 3);
   result.film_weight = r.value<double>();
   result.late_learns = r.value<uint8_t>() != 0;
-  if (result.late_learns) {
+  result.late_fallback = r.value<uint8_t>() != 0;
+  if (result.late_learns || result.late_fallback) {
     result.early_film = r.column<double>(size_t(w) * size_t(hgt) * 3);
     result.early_weight = r.value<double>(), result.late_ref_weight = r.value<double>();
   }
@@ -709,6 +711,13 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
   // the first passes were kept apart), summed as the render sums them.
   const bool staged = std::holds_alternative<bayes_sampler>(sampler) && stages_passes(params, weighting);
   if (result.late_learns && !(staged && result.spp >= staged_spp)) r.fail("staged pass weights");
+  // After a fallback (late_fallback), the passes before it are kept apart: those of the frame's first stratum_base
+  // spp (the fallback's own pass the last of them).
+  if (result.late_fallback) {
+    const auto* b = std::get_if<bayes_sampler>(&sampler);
+    if (!(b && b->fallback && weighting > 0 && !result.late_learns && result.stratum_base > 0))
+      r.fail("fallback pass weights");
+  }
   // A pass weighs as the first of its stratified light set (render.cpp): every pass before the set now running
   // started one of its own (the model changed after each), and every later one belongs to it.
   double weight = 0, early = 0, late_ref = 0;
@@ -719,6 +728,9 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
     weight += wk * (p.spp - spp);
     if (result.late_learns && spp < staged_spp) early = weight;
     if (result.late_learns && spp >= staged_spp) late_ref += pass_weight(set, weighting) * (p.spp - spp);
+    if (result.late_fallback && spp < result.stratum_base) early = weight;
+    if (result.late_fallback && spp >= result.stratum_base)
+      late_ref += (staged ? staged_pass_weight(spp, weighting, false) : pass_weight(spp, weighting)) * (p.spp - spp);
     spp = p.spp;
   }
   if (result.film_weight != weight) r.fail("film weight");

@@ -327,12 +327,17 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     result.film_weight = 0;
     result.early_film.clear();
     result.early_weight = result.late_ref_weight = 0;
-    result.late_learns = false;
+    result.late_learns = result.late_fallback = false;
     result.point_stats.clear();
     result.spp = result.passes = 0;
   }
   const double weighting = adapts(sampler) ? params.pass_weighting : 0.0;
   const bool staged = std::is_same_v<Sampler, bayes_sampler> && stages_passes(params, weighting);
+  // A pass's weight by its own start, whatever its light set (the plain schedule: the late passes' share after a
+  // fallback).
+  auto plain_weight = [&](int done) {
+    return staged ? staged_pass_weight(done, weighting, false) : pass_weight(done, weighting);
+  };
   if constexpr (std::is_same_v<Sampler, bayes_sampler>) {
     // The fallback check starts afresh with each frame (its first pass is not checked).
     if (result.spp == 0) sampler.restart_check();
@@ -484,13 +489,17 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     // unequal weights undo the set's stratification. While a sampler learns, every pass starts a set and weighs by
     // its own start; after bayes's fallback every later pass weighs as the first one after it. (By each pass's own
     // start, the Cornell box, direct, 640x480, falling back after 5 spp, had 1.9-2.0x power's relMSE at 32 spp, seeds
-    // 13-15; 1.4x by the set's, whose 27 samples stand against power's one set of 32.)
+    // 13-15; 1.4x by the set's, whose 27 samples stand against power's one set of 32.) The passes before the fallback
+    // are then kept apart (late_fallback), and the share of the image of those after it is what the plain schedule
+    // gives them: a share that followed the fallback's spp, which the check drew from the samples it weighs, biased
+    // the image.
     const int set_start = result.stratum_base;
     const double wk =
         staged ? staged_pass_weight(set_start, weighting, result.late_learns) : pass_weight(set_start, weighting);
     for (size_t i = 0; i < n; i++) result.film[i] += wk * pass_sum[i];
     result.film_weight += wk * count;
     if (result.late_learns) result.late_ref_weight += pass_weight(set_start, weighting) * count;
+    if (result.late_fallback) result.late_ref_weight += plain_weight(done) * count;
     if (auto_points) {  // (in row order: a tile's rows one after another)
       for (double& x : result.point_stats) x *= point_stats_decay;
       for (int y = 0; y < h; y++)
@@ -515,6 +524,13 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
         result.early_film = result.film;
         result.early_weight = result.film_weight;
         result.late_learns = true;
+      }
+      // The fallback: the passes so far keep their share of the image by the plain schedule, the later ones (one
+      // stratified set) weigh alike among themselves.
+      if (changed && weighting > 0) {
+        result.early_film = result.film;
+        result.early_weight = result.film_weight;
+        result.late_fallback = true;
       }
     }
     if constexpr (Sampler::learns) {

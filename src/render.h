@@ -79,11 +79,14 @@ struct render_result {
   // bayes's staged pass weights (staged_pass_weight, direct renders): where its fallback check had found learning to
   // pay by the end of its first staged_spp spp, the film's sums of those passes (F_e) and their weight W_e, kept
   // apart; the later passes' share of the image is that of the plain schedule, late_ref_weight their weight under it
-  // (film_image). Empty, 0 and false otherwise: the film alone is the image's sums.
+  // (film_image). Likewise after bayes's fallback to power sampling (late_fallback): the passes before it kept apart,
+  // the later ones weighing alike among themselves, with the share the plain schedule (their weights by their own
+  // starts) gives them. Empty, 0 and false otherwise: the film alone is the image's sums.
   std::vector<double> early_film;
   double early_weight = 0;
   double late_ref_weight = 0;
   bool late_learns = false;
+  bool late_fallback = false;
   // --light-points auto: the tiles' statistics of the completed passes (light_points.h; empty otherwise).
   std::vector<double> point_stats;
   int spp = 0;                // samples per pixel in the film

@@ -387,6 +387,7 @@ constexpr size_t pass_record_bytes = 4 + 4 + 8 + 1 + 3 * 8;
 // Offsets of the fields the test edits.
 struct checkpoint_fields {
   size_t passes, log, film, film_weight, point_stats, cut_nodes, pair_parent, pending, pending_slots, pending_count, moments;
+  size_t late_flags;  // late_learns, late_fallback (a byte each)
   size_t regions, regions_end;  // the region state: from its first column to the end of its pending table
   uint64_t parents = 0;  // entries of the pair_parent column
 };
@@ -399,8 +400,10 @@ checkpoint_fields locate_fields(checkpoint_bytes c, bool bayes) {
   f.log = c.value(log * pass_record_bytes);
   f.film = c.column(8);
   f.film_weight = c.value(8);
-  if (c.get<uint8_t>(c.value(1)) != 0) {  // bayes's staged weights: the first passes' film, its weight, the later ones'
-    c.column(8);
+  f.late_flags = c.pos;
+  const bool late_learns = c.get<uint8_t>(c.value(1)) != 0, late_fallback = c.get<uint8_t>(c.value(1)) != 0;
+  if (late_learns || late_fallback) {  // bayes's staged or fallback weights: the first passes' film, its weight, the
+    c.column(8);                       // later ones'
     c.value(8 + 8);
   }
   f.point_stats = c.column(8);  // (--light-points auto's; empty otherwise)
@@ -530,6 +533,17 @@ TEST_CASE("an edited checkpoint with a valid checksum is refused, never followed
     edit("film beyond float", [&](checkpoint_bytes& c) { c.put<double>(f.film, 1e300); });
     edit("film weight infinite", [&](checkpoint_bytes& c) { c.put<double>(f.film_weight, HUGE_VAL); });
     edit("passes", [&](checkpoint_bytes& c) { c.put<int>(f.passes, 2147483647); });
+    // Weights kept apart for a fallback that never happened (the film as the earlier passes' film, its weight as
+    // theirs, none after): an image of other shares than the render's.
+    if (bayes)
+      edit("fallback weights without a fallback", [&](checkpoint_bytes& c) {
+        REQUIRE(c.get<uint8_t>(f.late_flags) == 0);
+        REQUIRE(c.get<uint8_t>(f.late_flags + 1) == 0);
+        c.put<uint8_t>(f.late_flags + 1, 1);
+        const std::string film = base.b.substr(f.film - 8, f.film_weight - f.film + 8),  // (with its count)
+            weight = base.b.substr(f.film_weight, 8);
+        c.b = c.b.substr(0, f.late_flags + 2) + film + weight + std::string(8, '\0') + c.b.substr(f.late_flags + 2);
+      });
     // A pass that adds no samples (the second pass's total as the first's): bound's passes weigh alike, so the film's
     // weight, the last pass's total, still matches.
     if (!bayes)
