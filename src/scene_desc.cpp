@@ -129,9 +129,20 @@ int64_t get_integer(const desc_context& ctx, const json& v, const std::string& k
   return i;
 }
 
+// What a JSON value is, for messages: "a string", "an array", "null".
+std::string kind_of(const json& v) {
+  if (v.is_null()) return "null";
+  const std::string t = v.type_name();
+  return (t[0] == 'a' || t[0] == 'o' ? "an " : "a ") + t;
+}
+
 // An array of three finite numbers.
 vec3f get_vec3(const desc_context& ctx, const json& v, const std::string& key) {
   if (!v.is_array() || v.size() != 3) ctx.fail(key, "\"" + key + "\" must be an array of 3 numbers");
+  for (int i = 0; i < 3; i++)  // (which one is not: ["1", 1, 5] said only that "eye" must be a number)
+    if (!v[size_t(i)].is_number())
+      ctx.fail(key, "\"" + key + "\" must be an array of 3 numbers; its element " + std::to_string(i + 1) + " is " +
+                        kind_of(v[size_t(i)]));
   return {get_number(ctx, v[0], key), get_number(ctx, v[1], key), get_number(ctx, v[2], key)};
 }
 

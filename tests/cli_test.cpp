@@ -347,6 +347,23 @@ TEST_CASE("a scene key written as null takes its default", "[cli]") {
   CHECK(read_text(plain.dir / "out.pfm") == read_text(nulls.dir / "out.pfm"));
 }
 
+TEST_CASE("a vector with an element that is not a number names the element", "[cli]") {
+  // "eye": ["1", 1, 5] said only that "eye" must be a number (a review).
+  tiny_scene s;
+  const std::pair<const char*, const char*> cases[] = {{"[\"1\", 1, 5]", "its element 1 is a string"},
+                                                       {"[1, null, 5]", "its element 2 is null"},
+                                                       {"[1, 1, [5]]", "its element 3 is an array"}};
+  for (const auto& [eye, what] : cases) {
+    write_text(s.json,
+               std::string("{\"mesh\": \"box.obj\",\n \"camera\": {\"eye\": ") + eye + ", \"target\": [0, 0, 0]}}");
+    run_result r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "out.pfm"));
+    INFO(r.output);
+    CHECK(r.status == 3);
+    CHECK(r.output.find(":2: \"eye\" must be an array of 3 numbers; " + std::string(what)) != std::string::npos);
+    CHECK(!std::filesystem::exists(s.dir / "out.pfm"));
+  }
+}
+
 TEST_CASE("a plan view along the default up, tiny directions and fields of view at the interval's ends render",
           "[cli]") {
   // A view straight down without "up" was refused ("the default up is parallel"), a sun direction of 1e-300s was
