@@ -13,6 +13,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <new>
 
 namespace bl {
@@ -60,10 +61,17 @@ __m128 gloss_factor4(const shade_point& sp, __m128 cos_a, __m128 sin_t) {
 // cluster, below 2^-53 of the total, is drawn at that resolution rather than at its pmf; README, "All are unbiased".)
 double member_floor(float raw) { return std::isfinite(raw) ? double(raw) * min_positive_share : 0.0; }
 // The total weight of the n members w[0..n) of a cluster, each positive weight floored at `floor`.
-double members_total(const float* w, int n, double floor) {
+// A member's weight inside its cluster: an unseen member's at most the cluster's cap (bayes_params::unseen_cap).
+inline float member_weight(const float* w, const uint8_t* unseen, int k, float cap) {
+  return unseen[k] ? std::min(w[k], cap) : w[k];
+}
+
+double members_total(const float* w, const uint8_t* unseen, int n, double floor, float cap) {
   double total = 0;
-  for (int k = 0; k < n; k++)
-    if (w[k] > 0) total += std::max(double(w[k]), floor);
+  for (int k = 0; k < n; k++) {
+    const float x = member_weight(w, unseen, k, cap);
+    if (x > 0) total += std::max(double(x), floor);
+  }
   return total;
 }
 
@@ -170,6 +178,8 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
   const float* W = grouped ? (ctx.cv ? stats.gw_cv.data() : stats.gw.data()) + ctx.group_base : ctx.member_w;
   ctx.group_w = W;
   ctx.group_total = grouped ? (ctx.cv ? stats.gtot_cv.data() : stats.gtot.data()) + ctx.group_base : nullptr;
+  ctx.group_cap = grouped ? (ctx.cv ? stats.gcap_cv.data() : stats.gcap.data()) + ctx.group_base : nullptr;
+  ctx.member_unseen = stats.unseen.data() + base;
   const float* cvj = grouped ? stats.gcv.data() + ctx.group_base : stats.cv.data() + base;
   const float* mu0 = stats.mu0.data() + base;
   // The prior model's weight of cluster j at g = 1: the sum of its members' mu0.
@@ -272,6 +282,19 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
     std::fill(ctx.cdf, ctx.cdf + ctx.count + 1, 0.0);
     return;
   }
+  // Unseen clusters (bayes_params::unseen_cap: neither their members nor their coarse parents showed a non-zero
+  // sample in unseen_cap samples) weigh at most the heaviest cluster at this point that has shown one. (Their prior
+  // mean, the bound, keeps them far above it where a lamp far brighter than the others is shut away from the
+  // region.) Most regions have none: one scan of a byte per cluster.
+  const uint8_t* unseen = grouped ? stats.gunseen.data() + ctx.group_base : stats.unseen.data() + base;
+  if (std::memchr(unseen, 1, size_t(ctx.count)) != nullptr) {
+    double seen_max = 0;
+    for (int j = 0; j < ctx.count; j++)
+      if (!unseen[j]) seen_max = std::max(seen_max, w[j]);
+    if (seen_max > 0)
+      for (int j = 0; j < ctx.count; j++)
+        if (unseen[j]) w[j] = std::min(w[j], seen_max);
+  }
   // Defensive mixing with the prior-only pmf (mu0 g: the region's bound model; always a little for the naive
   // ablation, which can starve clusters).
   double eps = params.prior ? params.epsilon : std::max(params.epsilon, 1e-3);
@@ -340,13 +363,15 @@ light_choice bayes_sampler::sample_members(const context& ctx, double u, double 
     // u's place inside the cluster's cell, rescaled to the members' total weight (a cluster chosen has a positive
     // total: its weight is that sum); members of weight 0 are never chosen.
     const float* w = ctx.member_w;
+    const float cap = ctx.group_cap[j];
     double floor = member_floor(ctx.group_w[j]), total = ctx.group_total[j];
     double x = (u - ctx.cdf[j]) / pj * total, run = 0, start = 0, wm = 0;
     m = -1;
     for (int k = b; k < e; k++) {
-      if (!(w[k] > 0)) continue;
+      const float wk = member_weight(w, ctx.member_unseen, k, cap);
+      if (!(wk > 0)) continue;
       start = run;
-      wm = std::max(double(w[k]), floor);
+      wm = std::max(double(wk), floor);
       run += wm;
       m = k;
       if (x < run) break;
@@ -391,9 +416,9 @@ float bayes_sampler::members_pmf(const context& ctx, int light) const {
   double p = cluster_pmf(ctx, j);
   int b = ctx.member_begin[j], e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
   if (e - b > 1) {
-    const float* w = ctx.member_w;
+    const float wm = member_weight(ctx.member_w, ctx.member_unseen, m, ctx.group_cap[j]);
     double floor = member_floor(ctx.group_w[j]), total = ctx.group_total[j];
-    p = total > 0 && w[m] > 0 ? p * (std::max(double(w[m]), floor) / total) : 0.0;
+    p = total > 0 && wm > 0 ? p * (std::max(double(wm), floor) / total) : 0.0;
   }
   if (leaf != invalid_id) p *= intensity_descent_pmf(*tree, ctx.members[m], leaf);
   return float(p);
@@ -408,6 +433,9 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs, bool dirty_onl
   stats.gcol.resize(slots, vec3f{0, 0, 0});
   stats.gtot.resize(slots, 0.0);
   stats.gtot_cv.resize(slots, 0.0);
+  stats.gunseen.resize(slots + 16, 0);
+  stats.gcap.resize(slots, HUGE_VALF);
+  stats.gcap_cv.resize(slots, HUGE_VALF);
   const std::vector<int>& slot = regions.pair_slot;
   size_t npairs = slot.size();
   // The sums of the run of pairs of one cluster starting at `first` (a cluster's members are consecutive pairs).
@@ -420,10 +448,24 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs, bool dirty_onl
     // In one sweep: the columns' sums, and members_total's totals of the positive weights as if no floor applied,
     // with the least positive weight: where that is not below the floor (nearly always), the floor changed no term,
     // and the total is members_total's to the bit (the same terms added in the same order).
+    // Unseen members of a cluster that also has seen ones (bayes_params::unseen_cap) count for at most its heaviest
+    // seen member (w and w_cv apart); elsewhere the caps are infinite, and the sums those of the weights as they are.
+    const uint8_t* un = stats.unseen.data();
+    bool any_unseen = false, any_seen = false;
+    float cap_a = 0, cap_b = 0;
+    for (size_t k = first; k < end; k++) {
+      if (un[k]) {
+        any_unseen = true;
+      } else {
+        any_seen = true;
+        cap_a = std::max(cap_a, w[k]), cap_b = std::max(cap_b, wcv[k]);
+      }
+    }
+    if (!(any_unseen && any_seen)) cap_a = cap_b = HUGE_VALF;
     double a = 0, b = 0, c = 0, r = 0, gr = 0, bl = 0, ta = 0, tb = 0;
     float lo_a = HUGE_VALF, lo_b = HUGE_VALF;
     for (size_t k = first; k < end; k++) {
-      const float x = w[k], y = wcv[k], z = cv[k];
+      const float x = un[k] ? std::min(w[k], cap_a) : w[k], y = un[k] ? std::min(wcv[k], cap_b) : wcv[k], z = cv[k];
       a += x, b += y, c += z;
       if (x > 0) ta += double(x), lo_a = std::min(lo_a, x);
       if (y > 0) tb += double(y), lo_b = std::min(lo_b, y);
@@ -438,11 +480,14 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs, bool dirty_onl
     stats.gw[size_t(g)] = fa;
     stats.gw_cv[size_t(g)] = fb;
     stats.gcv[size_t(g)] = float(c);
+    stats.gunseen[size_t(g)] = any_unseen && !any_seen;
+    stats.gcap[size_t(g)] = cap_a, stats.gcap_cv[size_t(g)] = cap_b;
     stats.gcol[size_t(g)] = {float(r), float(gr), float(bl)};
     const int n = int(end - first);
     const double floor_a = member_floor(fa), floor_b = member_floor(fb);
-    stats.gtot[size_t(g)] = double(lo_a) >= floor_a ? ta : members_total(w + first, n, floor_a);
-    stats.gtot_cv[size_t(g)] = double(lo_b) >= floor_b ? tb : members_total(wcv + first, n, floor_b);
+    stats.gtot[size_t(g)] = double(lo_a) >= floor_a ? ta : members_total(w + first, un + first, n, floor_a, cap_a);
+    stats.gtot_cv[size_t(g)] =
+        double(lo_b) >= floor_b ? tb : members_total(wcv + first, un + first, n, floor_b, cap_b);
   };
   const std::vector<uint8_t>& dirty = stats.scratch.dirty;
   if (!pairs) {
@@ -673,6 +718,7 @@ size_t bayes_sampler::reserve_columns(size_t pairs, size_t entries, bool count_o
   };
   for (std::vector<float>* v : {&stats.mu0, &stats.p1_folded, &stats.k_folded}) room(*v, pairs);
   for (std::vector<float>* v : {&stats.w, &stats.w_cv, &stats.cv}) room(*v, pairs + 4);
+  room(stats.unseen, pairs + 16);
   room(stats.m, pairs);
   if (!params.region_prior) room(stats.weight, pairs);
   room(stats.scratch.seen, pairs);
@@ -686,6 +732,9 @@ size_t bayes_sampler::reserve_columns(size_t pairs, size_t entries, bool count_o
   room(stats.gcol, entries);
   room(stats.gtot, entries);
   room(stats.gtot_cv, entries);
+  room(stats.gunseen, entries + 16);
+  room(stats.gcap, entries);
+  room(stats.gcap_cv, entries);
   return bytes;
 }
 

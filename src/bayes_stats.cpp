@@ -22,6 +22,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
   s.w.resize(n + 4, 0.0f);
   s.w_cv.resize(n + 4, 0.0f);
   s.cv.resize(n + 4, 0.0f);
+  s.unseen.resize(n + 16, 0);
   if (n > old) {
     // All empty pairs share the prior-only coefficients (and, without data anywhere, the same weight).
     fold_weight(s, old, invalid_id, p, false);  // (no samples: no control variate, lamp or sun)
@@ -30,6 +31,7 @@ void resize_stats(bayes_stats& s, int64_t pairs, const bayes_params& p) {
       s.w[i] = s.w[old];
       s.w_cv[i] = s.w_cv[old];
       s.cv[i] = s.cv[old];
+      s.unseen[i] = s.unseen[old];
     }
   }
   s.p1_folded.resize(n, n == 0 ? 1.0f : own_p1(s, n - 1, p));

@@ -34,7 +34,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 22: Russian roulette's survival probability (path-traced images changed)
 // 23: the fallback check's first-vertex sum (path-traced renders)
 // 24: passes after bayes's fallback weigh as the first one after it
-constexpr uint32_t version = 25;  // 25: ... with the share of the plain schedule (the passes before it kept apart)
+// 25: ... with the share of the plain schedule (the passes before it kept apart)
+constexpr uint32_t version = 26;  // 26: bayes's unseen pairs (--bayes-unseen-cap)
 
 }  // namespace
 
@@ -264,6 +265,7 @@ void write_sampler(writer& w, const light_sampler& ls) {
     w.column(b->stats.cv);
     w.column(b->stats.p1_folded);
     w.column(b->stats.k_folded);
+    w.column(b->stats.unseen);  // (set as weights are folded, lazily like them)
     w.value(uint8_t(b->frozen));
     // The fallback check: its decision and votes, and the state it carries from one pass to the next (the per-pixel
     // sums are reset after every pass: only whether they run; the samples of a pass of one spp, to pair with).
@@ -303,6 +305,9 @@ void read_sampler(reader& r, light_sampler& ls, size_t pixels) {
     std::vector<float> wcol = r.column<float>(pairs + 4), w_cv = r.column<float>(pairs + 4),
                        cv = r.column<float>(pairs + 4), p1_folded = r.column<float>(pairs),
                        k_folded = r.column<float>(pairs);
+    std::vector<uint8_t> unseen = r.column<uint8_t>(pairs + 16);
+    for (size_t i = 0; i < unseen.size(); i++)
+      if (unseen[i] > (i < pairs && b->params.region_prior ? 1 : 0)) r.fail("sampling weights");
     auto valid = [](float x) { return std::isfinite(x) && x >= 0; };
     for (const std::vector<float>* c : {&wcol, &w_cv, &p1_folded, &k_folded})
       for (float x : *c)
@@ -340,6 +345,7 @@ void read_sampler(reader& r, light_sampler& ls, size_t pixels) {
     b->stats.cv = std::move(cv);
     b->stats.p1_folded = std::move(p1_folded);
     b->stats.k_folded = std::move(k_folded);
+    b->stats.unseen = std::move(unseen);
     b->refresh_groups(nullptr);  // the clusters' sums of the saved weights
   }
   if (auto* d = std::get_if<donikian_sampler>(&ls)) {
@@ -463,6 +469,7 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
     h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
     h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
     h.value(b.cv_every_vertex);
+    h.value(b.prior && b.region_prior ? b.unseen_cap : 0.0);
     // The early draws, where they can apply (direct illumination; one draw or no early spp: none).
     const bool early = p.max_depth == 1 && b.early_draws > std::max(1, p.light_samples) && b.early_spp > 0;
     h.value(early ? b.early_draws : 0), h.value(early ? b.early_spp : 0);

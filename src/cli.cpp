@@ -86,14 +86,15 @@ std::string unused_because(const std::string& name, const std::string& group, sa
     // Within bayes, the options its other options leave without effect.
     const bool naive = !o.bayes.prior, point = o.bayes_prior == "point", mean = o.bayes_pmf == "mean";
     if (naive && (name == "--bayes-a0" || name == "--bayes-b0" || name == "--bayes-kappa0" ||
-                  name == "--bayes-alpha0" || name == "--bayes-c" || name == "--bayes-no-mean-hierarchy"))
+                  name == "--bayes-alpha0" || name == "--bayes-c" || name == "--bayes-no-mean-hierarchy" ||
+                  name == "--bayes-unseen-cap"))
       return "no prior with --bayes-naive";
     const bool cv_option = name == "--bayes-cv-min-visible" || name == "--bayes-cv-sun-min-visible" ||
                            name == "--bayes-cv-last-only";
     if (point && (name == "--bayes-no-orientation" || name == "--bayes-no-bsdf-factor" || name == "--bayes-no-cv" ||
                   name == "--bayes-cv-last-only" ||
                   name == "--bayes-cv-min-visible" || name == "--bayes-cv-sun-min-visible" ||
-                  name == "--bayes-no-mean-hierarchy"))
+                  name == "--bayes-no-mean-hierarchy" || name == "--bayes-unseen-cap"))
       return "region prior only, not with --bayes-prior point";
     if (mean && (name == "--bayes-no-cv" || cv_option))
       return "control variates need --bayes-pmf second-moment";

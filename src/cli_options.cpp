@@ -149,6 +149,12 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_flag_callback("--bayes-naive", [&o] { o.bayes.prior = false; },
                        "Ablation: no Bayesian prior, plug-in sample moments (the naive adaptive method: clusters it starves are "
                        "never sampled again, so its images are biased in practice)")->group(bg);
+  r->add_option("--bayes-unseen-cap", o.bayes.unseen_cap,
+                "A cluster none of whose lights has given a region a non-zero sample in this many samples (its coarse "
+                "region's counted with it) weighs at a point at most the heaviest cluster there that has: its "
+                "prior, the bound, would keep a lamp far brighter than the others but shut away (in a box, the sun "
+                "outside a closed room) taking most samples for ever (default 8; 0: off, the paper's weights)")
+      ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-epsilon", o.bayes.epsilon, "Defensive mixing with the prior-only (bound) PMF, in [0, 1] (default 0)")
       ->check(CLI::Range(0.0, 1.0))->check(finite_number)->group(bg);
   // (At most 1e6 apart from the counts: the posterior mean of 1 - p0 stays far above float's least number.)

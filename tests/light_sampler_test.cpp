@@ -300,8 +300,9 @@ const sampler_kind all_kinds[] = {sampler_kind::uniform, sampler_kind::power, sa
 // Region options of the cut-based samplers: the defaults, small cuts on a coarse grid without members (clusters of
 // many lights, so the intensity descent inside clusters is exercised), and those small cuts with members (bayes:
 // clusters of several members, each chosen inside its cluster by its learned weight, then descended; the other
-// samplers ignore members).
-constexpr int param_variants = 3;
+// samplers ignore members), and (bayes) those with members whose unseen clusters and members are capped after a
+// single sample (bayes_params::unseen_cap 1: caps at many points, inside clusters too).
+constexpr int param_variants = 4;
 sampler_params params_variant(sampler_kind kind, int variant) {
   sampler_params p;
   p.kind = kind;
@@ -309,7 +310,8 @@ sampler_params params_variant(sampler_kind kind, int variant) {
     p.regions.max_cut = 4;
     p.regions.grid = 4;
   }
-  if (variant >= 1) p.regions.max_members = variant == 2 ? 16 : 0;
+  if (variant >= 1) p.regions.max_members = variant >= 2 ? 16 : 0;
+  if (variant == 3) p.bayes.unseen_cap = 1;
   return p;
 }
 
@@ -326,7 +328,7 @@ TEST_CASE("every light sampler satisfies the sampling contract", "[samplers]") {
       for (int variant = 0; variant < param_variants; variant++) {
         if (variant >= 1 && (kind == sampler_kind::uniform || kind == sampler_kind::power || kind == sampler_kind::bvh))
           continue;
-        if (variant == 2 && kind != sampler_kind::bayes) continue;  // members are the bayes sampler's only
+        if (variant >= 2 && kind != sampler_kind::bayes) continue;  // members are the bayes sampler's only
         INFO("sampler " << sampler_name(kind) << " sun " << sun << " variant " << variant);
         light_sampler ls = make_light_sampler(params_variant(kind, variant), t->in, t->tree);
         // The bvh sampler, like pbrt-v4's, gives up when both children of a node it descended into turn out to
@@ -351,7 +353,7 @@ TEST_CASE("evenly spaced selection numbers choose every light in proportion, ins
     if (!sampler_available(kind)) continue;
     for (int variant = 0; variant < param_variants; variant++) {
       if (variant >= 1 && (kind == sampler_kind::power || kind == sampler_kind::bvh)) continue;
-      if (variant == 2 && kind != sampler_kind::bayes) continue;
+      if (variant >= 2 && kind != sampler_kind::bayes) continue;
       INFO("sampler " << sampler_name(kind) << " variant " << variant);
       light_sampler ls = make_light_sampler(params_variant(kind, variant), t->in, t->tree);
       std::visit(
@@ -396,7 +398,7 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
     std::vector<shade_point> pts = shading_points(*t, 300, sun ? 3 : 4);
     for (sampler_kind kind : {sampler_kind::bound, sampler_kind::bayes}) {
       for (int variant = 0; variant < param_variants; variant++) {
-        if (variant == 2 && kind != sampler_kind::bayes) continue;
+        if (variant >= 2 && kind != sampler_kind::bayes) continue;
         INFO("sampler " << sampler_name(kind) << " sun " << sun << " variant " << variant);
         light_sampler ls = make_light_sampler(params_variant(kind, variant), t->in, t->tree);
         std::visit(
@@ -421,6 +423,13 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
           }
           CHECK(n > 0);
           CHECK(finite);
+          if (variant == 3) {  // (the caps did apply: unseen pairs, and clusters holding seen and unseen members)
+            size_t unseen = 0, capped = 0;
+            for (uint8_t u : b->stats.unseen) unseen += u;
+            for (float c : b->stats.gcap) capped += c < HUGE_VALF;
+            CHECK(unseen > 0);
+            CHECK(capped > 0);
+          }
         }
       }
     }
@@ -577,11 +586,13 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
   // Small cuts with members: clusters of several members whose weights learn apart. After every pass the cluster
   // columns must hold exactly the in-order sums of their members' current weights (refold refreshes only the clusters
   // of refolded pairs), and a member's probability must be its cluster's times its share of the cluster's weight.
+  // Where a cluster holds unseen members (bayes_params::unseen_cap) beside seen ones, an unseen member's weight counts
+  // for at most the heaviest seen member's (w and w_cv apart).
   auto t = make_test_scene(true);
   light_sampler ls = make_light_sampler(params_variant(sampler_kind::bayes, 2), t->in, t->tree);
   auto& s = std::get<bayes_sampler>(ls);
   REQUIRE(s.regions.members);
-  int grouped = 0, learned = 0;
+  int grouped = 0, learned = 0, mixed = 0;
   for (int round = 0; round < 4; round++) {
     learn_passes(t->in, s, 2);
     const region_state& r = s.regions;
@@ -589,15 +600,33 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
       int b = r.pair_offset[g], n = r.pair_count[g], c = r.cut_size[g], o = r.cut_offset[g];
       for (int j = 0; j < c; j++) {
         int e = j + 1 < c ? r.member_begin[size_t(o + j + 1)] : n;
+        float cap = 0, cap_cv = 0;
+        int unseen = 0, seen = 0;
+        for (int k = r.member_begin[size_t(o + j)]; k < e; k++) {
+          size_t i = size_t(b + k);
+          if (s.stats.unseen[i]) {
+            unseen++;
+          } else {
+            seen++;
+            cap = std::max(cap, s.stats.w[i]), cap_cv = std::max(cap_cv, s.stats.w_cv[i]);
+          }
+        }
+        if (unseen == 0 || seen == 0) cap = cap_cv = HUGE_VALF;
         double w = 0, w_cv = 0, cv = 0;
         for (int k = r.member_begin[size_t(o + j)]; k < e; k++) {
           size_t i = size_t(b + k);
           REQUIRE(r.pair_slot[i] == o + j);
-          w += s.stats.w[i], w_cv += s.stats.w_cv[i], cv += s.stats.cv[i];
+          const bool u = s.stats.unseen[i];
+          w += u ? std::min(s.stats.w[i], cap) : s.stats.w[i];
+          w_cv += u ? std::min(s.stats.w_cv[i], cap_cv) : s.stats.w_cv[i];
+          cv += s.stats.cv[i];
           learned += s.stats.m[i].n0 + s.stats.m[i].n1 > 0;
         }
         grouped += e - r.member_begin[size_t(o + j)] > 1;
+        mixed += unseen > 0 && seen > 0;
         INFO("region " << g << " cluster " << j);
+        CHECK(s.stats.gcap[size_t(o + j)] == cap);
+        CHECK(s.stats.gunseen[size_t(o + j)] == (seen == 0 && unseen > 0));
         CHECK(s.stats.gw[size_t(o + j)] == float(w));
         CHECK(s.stats.gw_cv[size_t(o + j)] == float(w_cv));
         CHECK(s.stats.gcv[size_t(o + j)] == float(cv));
@@ -606,6 +635,7 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
   }
   CHECK(grouped > 10);
   CHECK(learned > 100);
+  CHECK(mixed > 0);
   // A member's probability at a point: its cluster's times its weight over the cluster's (no weight here is so small
   // that the floor applies).
   std::vector<shade_point> pts = shading_points(*t, 50, 7);
@@ -618,9 +648,12 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
       if (c.light == invalid_id || ctx->pair_count == ctx->count) continue;
       int j = s.group_of(*ctx, c.cluster);
       int e = j + 1 < ctx->count ? ctx->member_begin[j + 1] : ctx->pair_count;
+      auto weight = [&](int k) {
+        return ctx->member_unseen[k] ? std::min(ctx->member_w[k], ctx->group_cap[j]) : ctx->member_w[k];
+      };
       double total = 0;
-      for (int k = ctx->member_begin[j]; k < e; k++) total += ctx->member_w[k];
-      CHECK(c.cluster_prob == Approx(cluster_pmf(*ctx, j) * ctx->member_w[c.cluster] / total).epsilon(1e-12));
+      for (int k = ctx->member_begin[j]; k < e; k++) total += weight(k);
+      CHECK(c.cluster_prob == Approx(cluster_pmf(*ctx, j) * weight(c.cluster) / total).epsilon(1e-12));
       checked++;
     }
   }
