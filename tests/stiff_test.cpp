@@ -250,19 +250,7 @@ TEST_CASE("a lamp 1e6 times brighter than the others, shut in a box, loses its s
   // mean of bayes minus uniform's (same seed) lies within 4.4 standard errors of 0. (Across seeds, not pixels: a
   // learned model's errors are shared by a region's pixels, so per-pixel differences understate the error.)
   for (int dims : {1, 24}) {
-    mesh_builder m;
-    int floor = m.add_material({0.5f, 0.5f, 0.5f});
-    int box = m.add_material({0.6f, 0.6f, 0.6f});
-    int bright = m.add_material({0, 0, 0}, {1e6f, 1e6f, 1e6f});
-    int dim = m.add_material({0, 0, 0}, {1, 1, 1});
-    m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
-    m.add_box({-0.5f, 0.01f, -0.5f}, {0.5f, 1, 0.5f}, box);
-    m.add_quad({-0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, 0.1f}, {-0.1f, 0.9f, 0.1f}, bright);
-    for (int k = 0; k < dims; k++) {  // a row of small lamps at y = 2 (one: a 0.5 x 0.5 square)
-      const float x = dims == 1 ? 1.0f : 0.4f + 0.1f * float(k), h = dims == 1 ? 0.5f : 0.05f;
-      m.add_quad({x, 2, -0.25f}, {x + h, 2, -0.25f}, {x + h, 2, 0.25f}, {x, 2, 0.25f}, dim);
-    }
-    auto b = build_test_scene(std::move(m.mesh), looking_down({2, 4, 0.01f}, {2, 0, 0}, 40));
+    auto b = build_test_scene(boxed_lamp_mesh(1e6f, dims), looking_down({2, 4, 0.01f}, {2, 0, 0}, 40));
     INFO(dims << " dim lamps");
     auto zero_share = [&](double cap) {
       render_params p;

@@ -207,18 +207,22 @@ struct mesh_builder {
   }
 };
 
-// A floor beside a closed box that holds a bright lamp (Ke 200), lit only by a dim lamp (Ke 1) outside the box:
-// a bound-style prior sends most NEE samples to the shut-in lamp. Seen well from eye (2, 4, 0.01) looking down.
-inline mesh_data boxed_lamp_mesh() {
+// A floor beside a closed box that holds a bright lamp (Ke `bright`, default 200), lit only by a dim lamp (Ke 1)
+// outside the box, a 0.5 x 0.5 square at y = 2, or `dims` small ones in a row there: a bound-style prior sends most
+// NEE samples to the shut-in lamp. Seen well from eye (2, 4, 0.01) looking down.
+inline mesh_data boxed_lamp_mesh(float bright_ke = 200, int dims = 1) {
   mesh_builder m;
   int floor = m.add_material({0.5f, 0.5f, 0.5f});
   int box = m.add_material({0.6f, 0.6f, 0.6f});
-  int bright = m.add_material({0, 0, 0}, {200, 200, 200});
+  int bright = m.add_material({0, 0, 0}, {bright_ke, bright_ke, bright_ke});
   int dim = m.add_material({0, 0, 0}, {1, 1, 1});
   m.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);
   m.add_box({-0.5f, 0.01f, -0.5f}, {0.5f, 1, 0.5f}, box);
   m.add_quad({-0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, -0.1f}, {0.1f, 0.9f, 0.1f}, {-0.1f, 0.9f, 0.1f}, bright);  // inside
-  m.add_quad({1, 2, -0.25f}, {1.5f, 2, -0.25f}, {1.5f, 2, 0.25f}, {1, 2, 0.25f}, dim);
+  for (int k = 0; k < dims; k++) {
+    const float x = dims == 1 ? 1.0f : 0.4f + 0.1f * float(k), h = dims == 1 ? 0.5f : 0.05f;
+    m.add_quad({x, 2, -0.25f}, {x + h, 2, -0.25f}, {x + h, 2, 0.25f}, {x, 2, 0.25f}, dim);
+  }
   return std::move(m.mesh);
 }
 
