@@ -7,6 +7,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <emmintrin.h>
 #include <xmmintrin.h>
 
 #include <algorithm>
@@ -61,17 +62,10 @@ __m128 gloss_factor4(const shade_point& sp, __m128 cos_a, __m128 sin_t) {
 // cluster, below 2^-53 of the total, is drawn at that resolution rather than at its pmf; README, "All are unbiased".)
 double member_floor(float raw) { return std::isfinite(raw) ? double(raw) * min_positive_share : 0.0; }
 // The total weight of the n members w[0..n) of a cluster, each positive weight floored at `floor`.
-// A member's weight inside its cluster: an unseen member's at most the cluster's cap (bayes_params::unseen_cap).
-inline float member_weight(const float* w, const uint8_t* unseen, int k, float cap) {
-  return unseen[k] ? std::min(w[k], cap) : w[k];
-}
-
-double members_total(const float* w, const uint8_t* unseen, int n, double floor, float cap) {
+double members_total(const float* w, int n, double floor) {
   double total = 0;
-  for (int k = 0; k < n; k++) {
-    const float x = member_weight(w, unseen, k, cap);
-    if (x > 0) total += std::max(double(x), floor);
-  }
+  for (int k = 0; k < n; k++)
+    if (w[k] > 0) total += std::max(double(w[k]), floor);
   return total;
 }
 
@@ -167,7 +161,9 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
     ctx.nodes = ctx.members;
   }
   const bool grouped = ctx.pair_count != ctx.count;
-  ctx.member_w = (ctx.cv ? stats.w_cv.data() : stats.w.data()) + base;
+  // (Inside a cluster members are chosen by their weights as capped there: bayes_stats::mw.)
+  ctx.member_w = (grouped ? (ctx.cv ? stats.mw_cv.data() : stats.mw.data())
+                          : (ctx.cv ? stats.w_cv.data() : stats.w.data())) + base;
   if (grouped) {
     // sample_members reads the chosen cluster's bounds, its members' weights and the chosen member's node right after
     // this: fetch the region's (consecutive, a few cache lines) while the weights below are computed.
@@ -178,8 +174,6 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
   const float* W = grouped ? (ctx.cv ? stats.gw_cv.data() : stats.gw.data()) + ctx.group_base : ctx.member_w;
   ctx.group_w = W;
   ctx.group_total = grouped ? (ctx.cv ? stats.gtot_cv.data() : stats.gtot.data()) + ctx.group_base : nullptr;
-  ctx.group_cap = grouped ? (ctx.cv ? stats.gcap_cv.data() : stats.gcap.data()) + ctx.group_base : nullptr;
-  ctx.member_unseen = stats.unseen.data() + base;
   const float* cvj = grouped ? stats.gcv.data() + ctx.group_base : stats.cv.data() + base;
   const float* mu0 = stats.mu0.data() + base;
   // The prior model's weight of cluster j at g = 1: the sum of its members' mu0.
@@ -210,6 +204,12 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
   const __m128 zero = _mm_setzero_ps();
   int front_mask = 0;  // some cluster can reach the point
   vec3f cv_sum = {0, 0, 0};
+  // Unseen clusters (bayes_params::unseen_cap; + 16 padding, so four flags are read at any j0): which lanes hold one,
+  // and the heaviest weight of the others.
+  const uint8_t* unseen = grouped ? stats.gunseen.data() + ctx.group_base : stats.unseen.data() + base;
+  const __m128i zi = _mm_setzero_si128(), lane_index = _mm_setr_epi32(0, 1, 2, 3);
+  __m128 seen_v = zero;
+  int unseen_mask = 0;
   for (int j0 = 0; j0 < tc; j0 += 4) {
     // (cx, cy, cz, r) of four nodes (missing lanes repeat the last node; their results are never read).
     __m128 c0 = _mm_loadu_ps(&tree->packed[size_t(ctx.nodes[std::min(j0 + 0, tc - 1)])].cx);
@@ -245,6 +245,15 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
     _mm_store_pd(w + j0 + 2, _mm_cvtps_pd(_mm_movehl_ps(wv, wv)));
     const int lanes = tc - j0 >= 4 ? 0xf : (1 << (tc - j0)) - 1;  // the lanes of real clusters
     front_mask |= _mm_movemask_ps(_mm_cmpgt_ps(g, zero)) & lanes;
+    {
+      uint32_t f4;
+      std::memcpy(&f4, unseen + j0, 4);
+      const __m128i fi = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(int(f4)), zi), zi);
+      const __m128 un = _mm_castsi128_ps(_mm_cmpgt_epi32(fi, zi));
+      const __m128 real = _mm_castsi128_ps(_mm_cmpgt_epi32(_mm_set1_epi32(tc - j0), lane_index));
+      unseen_mask |= _mm_movemask_ps(un) & lanes;
+      seen_v = _mm_max_ps(seen_v, _mm_andnot_ps(un, _mm_and_ps(real, wv)));
+    }
     if (ctx.cv) {
       // c_j = (E[1 - p0] k_j) g_j, zero behind the surface like the weight, and their colour-weighted sum in
       // cluster order (most pairs have no control variate: c_j = 0, skipped four at a time).
@@ -285,15 +294,16 @@ void bayes_sampler::prepare_region_prior(context& ctx, const shade_point& sp, bo
   // Unseen clusters (bayes_params::unseen_cap: neither their members nor their coarse parents showed a non-zero
   // sample in unseen_cap samples) weigh at most the heaviest cluster at this point that has shown one. (Their prior
   // mean, the bound, keeps them far above it where a lamp far brighter than the others is shut away from the
-  // region.) Most regions have none: one scan of a byte per cluster.
-  const uint8_t* unseen = grouped ? stats.gunseen.data() + ctx.group_base : stats.unseen.data() + base;
-  if (std::memchr(unseen, 1, size_t(ctx.count)) != nullptr) {
-    double seen_max = 0;
-    for (int j = 0; j < ctx.count; j++)
-      if (!unseen[j]) seen_max = std::max(seen_max, w[j]);
+  // region.) The flags and the others' heaviest weight came with the weights above (a loop of its own here, with the
+  // maximum's dependency chain, added a quarter to the hall's PMF build).
+  const bool sun_unseen = tc < ctx.count && unseen[tc];
+  if (unseen_mask != 0 || sun_unseen) {
+    alignas(16) float lane_max[4];
+    _mm_store_ps(lane_max, seen_v);
+    double seen_max = std::max(std::max(lane_max[0], lane_max[1]), std::max(lane_max[2], lane_max[3]));
+    if (tc < ctx.count && !sun_unseen) seen_max = std::max(seen_max, w[tc]);
     if (seen_max > 0)
-      for (int j = 0; j < ctx.count; j++)
-        if (unseen[j]) w[j] = std::min(w[j], seen_max);
+      for (int j = 0; j < ctx.count; j++) w[j] = unseen[j] ? std::min(w[j], seen_max) : w[j];
   }
   // Defensive mixing with the prior-only pmf (mu0 g: the region's bound model; always a little for the naive
   // ablation, which can starve clusters).
@@ -363,15 +373,13 @@ light_choice bayes_sampler::sample_members(const context& ctx, double u, double 
     // u's place inside the cluster's cell, rescaled to the members' total weight (a cluster chosen has a positive
     // total: its weight is that sum); members of weight 0 are never chosen.
     const float* w = ctx.member_w;
-    const float cap = ctx.group_cap[j];
     double floor = member_floor(ctx.group_w[j]), total = ctx.group_total[j];
     double x = (u - ctx.cdf[j]) / pj * total, run = 0, start = 0, wm = 0;
     m = -1;
     for (int k = b; k < e; k++) {
-      const float wk = member_weight(w, ctx.member_unseen, k, cap);
-      if (!(wk > 0)) continue;
+      if (!(w[k] > 0)) continue;
       start = run;
-      wm = std::max(double(wk), floor);
+      wm = std::max(double(w[k]), floor);
       run += wm;
       m = k;
       if (x < run) break;
@@ -416,9 +424,9 @@ float bayes_sampler::members_pmf(const context& ctx, int light) const {
   double p = cluster_pmf(ctx, j);
   int b = ctx.member_begin[j], e = j + 1 < ctx.count ? ctx.member_begin[j + 1] : ctx.pair_count;
   if (e - b > 1) {
-    const float wm = member_weight(ctx.member_w, ctx.member_unseen, m, ctx.group_cap[j]);
+    const float* w = ctx.member_w;
     double floor = member_floor(ctx.group_w[j]), total = ctx.group_total[j];
-    p = total > 0 && wm > 0 ? p * (std::max(double(wm), floor) / total) : 0.0;
+    p = total > 0 && w[m] > 0 ? p * (std::max(double(w[m]), floor) / total) : 0.0;
   }
   if (leaf != invalid_id) p *= intensity_descent_pmf(*tree, ctx.members[m], leaf);
   return float(p);
@@ -434,14 +442,15 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs, bool dirty_onl
   stats.gtot.resize(slots, 0.0);
   stats.gtot_cv.resize(slots, 0.0);
   stats.gunseen.resize(slots + 16, 0);
-  stats.gcap.resize(slots, HUGE_VALF);
-  stats.gcap_cv.resize(slots, HUGE_VALF);
+  stats.mw.resize(stats.m.size() + 4, 0.0f);
+  stats.mw_cv.resize(stats.m.size() + 4, 0.0f);
   const std::vector<int>& slot = regions.pair_slot;
   size_t npairs = slot.size();
   // The sums of the run of pairs of one cluster starting at `first` (a cluster's members are consecutive pairs).
   auto sum_run = [&](size_t first) {
     const int* sl = slot.data();
     const float *w = stats.w.data(), *wcv = stats.w_cv.data(), *cv = stats.cv.data();
+    float *mw = stats.mw.data(), *mwcv = stats.mw_cv.data();
     const int g = sl[first];
     size_t end = first + 1;
     while (end < npairs && sl[end] == g) end++;
@@ -466,6 +475,7 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs, bool dirty_onl
     float lo_a = HUGE_VALF, lo_b = HUGE_VALF;
     for (size_t k = first; k < end; k++) {
       const float x = un[k] ? std::min(w[k], cap_a) : w[k], y = un[k] ? std::min(wcv[k], cap_b) : wcv[k], z = cv[k];
+      mw[k] = x, mwcv[k] = y;
       a += x, b += y, c += z;
       if (x > 0) ta += double(x), lo_a = std::min(lo_a, x);
       if (y > 0) tb += double(y), lo_b = std::min(lo_b, y);
@@ -481,13 +491,11 @@ void bayes_sampler::refresh_groups(const std::vector<int>* pairs, bool dirty_onl
     stats.gw_cv[size_t(g)] = fb;
     stats.gcv[size_t(g)] = float(c);
     stats.gunseen[size_t(g)] = any_unseen && !any_seen;
-    stats.gcap[size_t(g)] = cap_a, stats.gcap_cv[size_t(g)] = cap_b;
     stats.gcol[size_t(g)] = {float(r), float(gr), float(bl)};
     const int n = int(end - first);
     const double floor_a = member_floor(fa), floor_b = member_floor(fb);
-    stats.gtot[size_t(g)] = double(lo_a) >= floor_a ? ta : members_total(w + first, un + first, n, floor_a, cap_a);
-    stats.gtot_cv[size_t(g)] =
-        double(lo_b) >= floor_b ? tb : members_total(wcv + first, un + first, n, floor_b, cap_b);
+    stats.gtot[size_t(g)] = double(lo_a) >= floor_a ? ta : members_total(mw + first, n, floor_a);
+    stats.gtot_cv[size_t(g)] = double(lo_b) >= floor_b ? tb : members_total(mwcv + first, n, floor_b);
   };
   const std::vector<uint8_t>& dirty = stats.scratch.dirty;
   if (!pairs) {
@@ -729,12 +737,11 @@ size_t bayes_sampler::reserve_columns(size_t pairs, size_t entries, bool count_o
   room(regions.member_begin, entries);
   if (!regions.members) return bytes;
   for (std::vector<float>* v : {&stats.gw, &stats.gw_cv, &stats.gcv}) room(*v, entries + 4);
+  for (std::vector<float>* v : {&stats.mw, &stats.mw_cv}) room(*v, pairs + 4);
   room(stats.gcol, entries);
   room(stats.gtot, entries);
   room(stats.gtot_cv, entries);
   room(stats.gunseen, entries + 16);
-  room(stats.gcap, entries);
-  room(stats.gcap_cv, entries);
   return bytes;
 }
 

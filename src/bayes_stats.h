@@ -155,9 +155,10 @@ struct bayes_stats {
   std::vector<vec3f> gcol;               // members, per cut entry: the sum of its members' colour times cv (a point's
                                          // control-variate total adds it times the cluster's point factor)
   std::vector<uint8_t> gunseen;          // members, per cut entry: every member unseen (+ 16 padding)
-  std::vector<float> gcap, gcap_cv;      // members, per cut entry: the most an unseen member's w, resp. w_cv, counts
-                                         // for inside it: its heaviest seen member's (HUGE_VALF where none or all
-                                         // are unseen); its sums and totals are of the members' weights so capped
+  std::vector<float> mw, mw_cv;          // members, per pair: its w and w_cv as its cluster chooses members by them
+                                         // (+ 4 padding each): an unseen member's at most the heaviest seen member's
+                                         // of its cluster (bayes_params::unseen_cap), else its own; the cluster sums
+                                         // and totals above are of these
   merge_buffers scratch;
   pair_coeffs empty = {};  // pair_coefficients of a pair without samples (set by resize_stats from the parameters)
 };

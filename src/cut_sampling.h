@@ -44,8 +44,6 @@ struct cut_context {
   const float* member_w = nullptr;  // bayes: the members' weight column a point chose from (inside a cluster)
   const float* group_w = nullptr;   // bayes: the clusters' column it weighed them by (their members' summed weights)
   const double* group_total = nullptr;  // bayes: per cluster, the members' total a member is chosen from
-  const float* group_cap = nullptr;     // bayes: per cluster, the most an unseen member weighs in it (unseen_cap)
-  const uint8_t* member_unseen = nullptr;  // bayes: the members' unseen flags
   double cdf[max_cut_entries + 1];
   // Control variates (bayes): whether they apply at this point, sum_j colour_j c_j and c_j per cluster, with c_j
   // the learned mean of cluster j's albedo-free sample (the integrator scales by (kd + ks) / pi).

@@ -426,7 +426,7 @@ TEST_CASE("learning samplers satisfy the sampling contract after learning", "[sa
           if (variant == 3) {  // (the caps did apply: unseen pairs, and clusters holding seen and unseen members)
             size_t unseen = 0, capped = 0;
             for (uint8_t u : b->stats.unseen) unseen += u;
-            for (float c : b->stats.gcap) capped += c < HUGE_VALF;
+            for (size_t i = 0; i < b->stats.m.size(); i++) capped += b->stats.mw[i] < b->stats.w[i];
             CHECK(unseen > 0);
             CHECK(capped > 0);
           }
@@ -617,15 +617,17 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
           size_t i = size_t(b + k);
           REQUIRE(r.pair_slot[i] == o + j);
           const bool u = s.stats.unseen[i];
-          w += u ? std::min(s.stats.w[i], cap) : s.stats.w[i];
-          w_cv += u ? std::min(s.stats.w_cv[i], cap_cv) : s.stats.w_cv[i];
+          const float mw = u ? std::min(s.stats.w[i], cap) : s.stats.w[i];
+          const float mw_cv = u ? std::min(s.stats.w_cv[i], cap_cv) : s.stats.w_cv[i];
+          CHECK(s.stats.mw[i] == mw);
+          CHECK(s.stats.mw_cv[i] == mw_cv);
+          w += mw, w_cv += mw_cv;
           cv += s.stats.cv[i];
           learned += s.stats.m[i].n0 + s.stats.m[i].n1 > 0;
         }
         grouped += e - r.member_begin[size_t(o + j)] > 1;
         mixed += unseen > 0 && seen > 0;
         INFO("region " << g << " cluster " << j);
-        CHECK(s.stats.gcap[size_t(o + j)] == cap);
         CHECK(s.stats.gunseen[size_t(o + j)] == (seen == 0 && unseen > 0));
         CHECK(s.stats.gw[size_t(o + j)] == float(w));
         CHECK(s.stats.gw_cv[size_t(o + j)] == float(w_cv));
@@ -648,12 +650,10 @@ TEST_CASE("a bayes cluster of several members weighs the sum of its members' wei
       if (c.light == invalid_id || ctx->pair_count == ctx->count) continue;
       int j = s.group_of(*ctx, c.cluster);
       int e = j + 1 < ctx->count ? ctx->member_begin[j + 1] : ctx->pair_count;
-      auto weight = [&](int k) {
-        return ctx->member_unseen[k] ? std::min(ctx->member_w[k], ctx->group_cap[j]) : ctx->member_w[k];
-      };
-      double total = 0;
-      for (int k = ctx->member_begin[j]; k < e; k++) total += weight(k);
-      CHECK(c.cluster_prob == Approx(cluster_pmf(*ctx, j) * weight(c.cluster) / total).epsilon(1e-12));
+      double total = 0;  // (the members' weights as capped inside the cluster)
+      for (int k = ctx->member_begin[j]; k < e; k++) total += ctx->member_w[k];
+      REQUIRE(ctx->member_w == (ctx->cv ? s.stats.mw_cv.data() : s.stats.mw.data()) + ctx->pair_base);
+      CHECK(c.cluster_prob == Approx(cluster_pmf(*ctx, j) * ctx->member_w[c.cluster] / total).epsilon(1e-12));
       checked++;
     }
   }
