@@ -171,7 +171,8 @@ size_t sampler_memory_bytes(const light_sampler& s) {
     return region_memory_bytes(b->regions) + bytes_of(st.m) + bytes_of(st.weight) +
            bytes_of(st.mu0) + bytes_of(st.w) + bytes_of(st.w_cv) + bytes_of(st.cv) + bytes_of(st.p1_folded) +
            bytes_of(st.k_folded) + bytes_of(st.gw) + bytes_of(st.gw_cv) + bytes_of(st.gcv) + bytes_of(st.gcol) +
-           bytes_of(st.gtot) + bytes_of(st.gtot_cv) + bytes_of(b->child_link) +
+           bytes_of(st.gtot) + bytes_of(st.gtot_cv) + bytes_of(st.unseen) + bytes_of(st.gunseen) + bytes_of(st.mw) +
+           bytes_of(st.mw_cv) + bytes_of(b->child_link) +
            bytes_of(b->px_var) + bytes_of(b->px_delta) + bytes_of(b->px_first) + bytes_of(b->px_prev) +
            bytes_of(b->px_cur);
   }
