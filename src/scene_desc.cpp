@@ -297,6 +297,10 @@ scene_desc load_scene_desc(const std::string& path) {
     size_t second = first == std::string::npos ? first : ctx.find_quoted(duplicate, first + 1);
     throw input_error(path, ctx.line_at(second), "key \"" + shorten(duplicate) + "\" is given twice in one object");
   }
+  // (A whole file that is not an object: its value's line, which a key search cannot find.)
+  if (!root.is_object())
+    throw input_error(path, ctx.line_at(ctx.text.find_first_not_of(" \t\r\n")),
+                      "the scene file must be a JSON object ({\"mesh\": ...}), not " + kind_of(root));
   check_keys(ctx, root, "the scene file", {"mesh", "camera", "image", "render", "sun", "two_sided_emitters"});
   if (!root.contains("mesh")) throw input_error(path, "missing required key \"mesh\"");
   if (!root["mesh"].is_string() || root["mesh"].get<std::string>().empty())

@@ -364,6 +364,20 @@ TEST_CASE("a vector with an element that is not a number names the element", "[c
   }
 }
 
+TEST_CASE("a scene file that is not an object says what it is, with its line", "[cli]") {
+  // [1, 2, 3] as a whole scene file said only that "the scene file" must be an object, with no line (a review).
+  tiny_scene s;
+  const std::pair<const char*, const char*> cases[] = {{"\n\n [1, 2, 3]\n", ":3: the scene file must be a JSON object"},
+                                                       {"\"box.obj\"", ":1: the scene file must be a JSON object"}};
+  for (const auto& [text, what] : cases) {
+    write_text(s.json, text);
+    run_result r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "out.pfm"));
+    INFO(r.output);
+    CHECK(r.status == 3);
+    CHECK(r.output.find(s.json + what) != std::string::npos);
+  }
+}
+
 TEST_CASE("a plan view along the default up, tiny directions and fields of view at the interval's ends render",
           "[cli]") {
   // A view straight down without "up" was refused ("the default up is parallel"), a sun direction of 1e-300s was
