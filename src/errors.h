@@ -16,11 +16,18 @@ constexpr int exit_usage = 2;
 constexpr int exit_bad_input = 3;
 
 // Bad input file: the message reads "FILE:LINE: what" (or "FILE: what" when there is no line).
+// A file name as a message shows it: one longer than any path the system takes (4096 bytes) by its two ends (a
+// scene's 10 MB "mesh" name was echoed whole; a review).
+inline std::string shown_file_name(const std::string& f) {
+  if (f.size() <= 4096) return f;
+  return f.substr(0, 200) + "...(" + std::to_string(f.size()) + " characters)..." + f.substr(f.size() - 100);
+}
 struct input_error : std::runtime_error {
   std::string file;
   int line = 0;
   input_error(const std::string& file_, int line_, const std::string& what)
-      : std::runtime_error(file_ + (line_ > 0 ? ":" + std::to_string(line_) : std::string()) + ": " + what),
+      : std::runtime_error(shown_file_name(file_) + (line_ > 0 ? ":" + std::to_string(line_) : std::string()) +
+                           ": " + what),
         file(file_),
         line(line_) {}
   input_error(const std::string& file_, const std::string& what) : input_error(file_, 0, what) {}

@@ -246,6 +246,8 @@ scene_desc load_scene_desc(const std::string& path) {
   scene_desc desc;
   desc.path = path;
   std::string ext = lower_extension(path);
+  // (An empty argument, `render ""`: said ": unknown scene type" with no name before it.)
+  if (path.empty()) throw input_error("(an empty scene path)", "give a .json scene file or a .obj mesh");
   if (ext != ".json" && ext != ".obj")
     throw input_error(path, "unknown scene type \"" + ext + "\" (expected a .json scene file or a .obj mesh)");
   std::error_code ec;

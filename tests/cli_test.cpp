@@ -378,6 +378,29 @@ TEST_CASE("a scene file that is not an object says what it is, with its line", "
   }
 }
 
+TEST_CASE("an empty scene path is named as such", "[cli]") {
+  // `render ""` said ": unknown scene type" with no name (a review).
+  temp_dir d;
+  run_result r = run_bayeslight("render \"\" --quiet -o " + (d / "out.pfm"));
+  INFO(r.output);
+  CHECK(r.status == 3);
+  CHECK(r.output.find("(an empty scene path): give a .json scene file or a .obj mesh") != std::string::npos);
+  CHECK(!std::filesystem::exists(d / "out.pfm"));
+}
+
+TEST_CASE("a file name longer than any path is shown by its two ends", "[cli]") {
+  // A scene's 10 MB "mesh" name was echoed whole in the error (a review).
+  tiny_scene s;
+  write_text(s.json, "{\"mesh\": \"" + std::string(100000, 'm') + ".obj\"}");
+  run_result r = run_bayeslight("render " + s.json + " --quiet -o " + (s.dir / "out.pfm"));
+  INFO(r.output.substr(0, 2000));
+  CHECK(r.status == 3);
+  CHECK(r.output.size() < 1000);
+  CHECK(r.output.find("mmm...(") != std::string::npos);  // (the name's length with the scene's directory)
+  CHECK(r.output.find(" characters)...mmm") != std::string::npos);
+  CHECK(r.output.find("m.obj: cannot open OBJ file") != std::string::npos);
+}
+
 TEST_CASE("a plan view along the default up, tiny directions and fields of view at the interval's ends render",
           "[cli]") {
   // A view straight down without "up" was refused ("the default up is parallel"), a sun direction of 1e-300s was
