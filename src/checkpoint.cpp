@@ -737,7 +737,7 @@ uint64_t decode_checkpoint(const std::string& bytes, const std::string& path,
     if (result.late_learns && spp >= staged_spp) late_ref += pass_weight(set, weighting) * (p.spp - spp);
     if (result.late_fallback && spp < result.stratum_base) early = weight;
     if (result.late_fallback && spp >= result.stratum_base)
-      late_ref += (staged ? staged_pass_weight(spp, weighting, false) : pass_weight(spp, weighting)) * (p.spp - spp);
+      late_ref += plain_pass_weight(spp, weighting, staged) * (p.spp - spp);
     spp = p.spp;
   }
   if (result.film_weight != weight) r.fail("film weight");

@@ -333,11 +333,6 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
   }
   const double weighting = adapts(sampler) ? params.pass_weighting : 0.0;
   const bool staged = std::is_same_v<Sampler, bayes_sampler> && stages_passes(params, weighting);
-  // A pass's weight by its own start, whatever its light set (the plain schedule: the late passes' share after a
-  // fallback).
-  auto plain_weight = [&](int done) {
-    return staged ? staged_pass_weight(done, weighting, false) : pass_weight(done, weighting);
-  };
   if constexpr (std::is_same_v<Sampler, bayes_sampler>) {
     // The fallback check starts afresh with each frame (its first pass is not checked).
     if (result.spp == 0) sampler.restart_check();
@@ -499,7 +494,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     for (size_t i = 0; i < n; i++) result.film[i] += wk * pass_sum[i];
     result.film_weight += wk * count;
     if (result.late_learns) result.late_ref_weight += pass_weight(set_start, weighting) * count;
-    if (result.late_fallback) result.late_ref_weight += plain_weight(done) * count;
+    if (result.late_fallback) result.late_ref_weight += plain_pass_weight(done, weighting, staged) * count;
     if (auto_points) {  // (in row order: a tile's rows one after another)
       for (double& x : result.point_stats) x *= point_stats_decay;
       for (int y = 0; y < h; y++)

@@ -137,6 +137,10 @@ constexpr int staged_spp = 8;
 constexpr double staged_early = 4, staged_late = 16;
 bool stages_passes(const render_params& params, double weighting);
 double staged_pass_weight(int done, double s, bool late_learns);
+// A pass's weight by its own start (the plain schedule): the share of the passes after bayes's fallback.
+inline double plain_pass_weight(int done, double s, bool staged) {
+  return staged ? staged_pass_weight(done, s, false) : pass_weight(done, s);
+}
 // Whether the sampler's passes are weighted by pass_weight (an adaptive sampler that still learns).
 bool sampler_adapts(const light_sampler& s);
 
