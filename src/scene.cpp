@@ -127,10 +127,25 @@ scene_data build_scene(const scene_desc& desc, float aspect) {
     // renders a distorted image, or a black one: an eye 1e8 from the origin with a field of view of 5e-6
     // degrees framing a 10-unit stage wrote zeros without a word (a review). Rounding of the eye's coordinates and
     // of the ray's direction over the distance to the target.
+    // The direction errs by the rounding of the coordinates eye and target differ in, across the view only: a target
+    // on an axis through the eye gives an exact direction however near (a target 1e-6 before the eye was warned
+    // about, its image that of a far target; a review). The eye's own rounding errs by an ulp of its coordinates at
+    // the scene, taken at the target or at the scene bounds' centre, whichever is farther.
     const float dist = length(dir);
-    const double view = 2.0 * double(dist) * std::tan(double(s.camera.fov_y_deg) * M_PI / 360.0);
+    const double tan_half = std::tan(double(s.camera.fov_y_deg) * M_PI / 360.0);
     const float far = max_abs_component(s.camera.eye);
-    const double rounding = double(std::nextafter(far, INFINITY) - far) + double(dist) * std::ldexp(1.0, -23);
+    auto ulp = [](float v) { return double(std::nextafter(v, INFINITY) - v); };
+    double across = 0;
+    for (int a = 0; a < 3; a++)
+      if (s.camera.eye[a] != s.camera.target[a]) {
+        const double along = double(dir[a]) / double(dist);
+        across += ulp(std::max(std::fabs(s.camera.eye[a]), std::fabs(s.camera.target[a]))) *
+                  std::sqrt(std::max(0.0, 1.0 - along * along));
+      }
+    const double scene_dist = std::max(double(dist), double(length(center(s.bounds) - s.camera.eye)));
+    // (as an angle: radians, against the view's 2 tan(fov / 2))
+    const double angle = across / double(dist) + ulp(far) / scene_dist + std::ldexp(1.0, -23);
+    const double view = 2.0 * double(dist) * tan_half, rounding = angle * double(dist);
     if (!(rounding <= 1e-2 * view)) {
       char buf[512];
       std::snprintf(buf, sizeof buf,

@@ -439,6 +439,16 @@ TEST_CASE("a plan view along the default up, tiny directions and fields of view 
                                               "\"target\": [0, 0.5, 0], \"fov_y_deg\": 1e-300}}");
   CHECK(narrow.find("warning: the camera's rays are placed only to about") != std::string::npos);
   CHECK(plan.find("warning: the camera's rays") == std::string::npos);
+  // A target a millionth before the eye on an axis through it: an exact direction, the image of a far target, no
+  // warning (it was warned about; a review). Off the axis by a few ulps, the direction is not exact: warned.
+  const std::string near = render("near", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], "
+                                          "\"target\": [0, 0.5, 1.999999]}}");
+  CHECK(near.find("warning: the camera's rays") == std::string::npos);
+  render("far", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0, 0.5, 2], \"target\": [0, 0.5, 0]}}");
+  CHECK(read_text(s.dir / "near.pfm") == read_text(s.dir / "far.pfm"));
+  const std::string skew = render("skew", "{\"mesh\": \"box.obj\", \"camera\": {\"eye\": [0.3, 0.5, 2], "
+                                          "\"target\": [0.3000001, 0.5, 1.999999]}}");
+  CHECK(skew.find("warning: the camera's rays are placed only to about") != std::string::npos);
 }
 
 TEST_CASE("a camera too far away for float to place its rays is warned about", "[cli]") {
