@@ -198,6 +198,22 @@ void warn_unused_options(const render_options& o, const std::vector<sampler_kind
                  unused.c_str());
 }
 
+// Whether option `name` was given on the command line.
+static bool option_given(const render_options& o, const std::string& name) {
+  for (const auto& g : o.given)
+    if (g.first == name) return true;
+  return false;
+}
+
+// Regions coarser than the grid asks for, once the mesh's bounds are known (light_sampler.h).
+static void warn_coarse_grid(const render_options& o, const render_params& params, const scene_data& scene,
+                             const light_data& lights) {
+  const std::string w =
+      coarse_grid_warning(params.sampler, params.max_depth, int64_t(params.width) * params.height, scene.bounds,
+                          int(lights.tri.size()), option_given(o, "--grid"));
+  if (!w.empty()) std::fprintf(stderr, "%s: warning: %s\n", o.scene.c_str(), w.c_str());
+}
+
 // What only the scene (its max depth, image size) tells: fine regions at depths the paths never reach, donikian's
 // region options at max depth 1, and settings that may take gigabytes (warn_unused_options runs before the scene is
 // read). Each option is named once.
@@ -213,11 +229,7 @@ void warn_after_scene(const render_options& o, const render_params& params, cons
         return true;
     return false;
   };
-  auto given = [&](const std::string& name) {
-    for (const auto& g : o.given)
-      if (g.first == name) return true;
-    return false;
-  };
+  auto given = [&](const std::string& name) { return option_given(o, name); };
   // donikian keeps every pixel's estimate of each cluster of its cut (up to --max-cut and the sun, 4 bytes each): 6.7
   // GB at 4096x4096 in a review, with nothing said before.
   if (donikian) {
@@ -536,6 +548,7 @@ int run_render(const render_options& o) {
   light_data lights = build_lights(scene);
   loading.reset();
   warn_about_lights(o.scene, scene, bvh, lights);
+  warn_coarse_grid(o, params, scene, lights);
   if (!o.quiet) {
     auto t_end = std::chrono::steady_clock::now();
     std::fprintf(stderr, "%s: %zu triangles, %d lights%s; loaded in %.2f s, Embree BVH and lights in %.2f s\n",
@@ -671,6 +684,7 @@ int run_profile_command(const render_options& o) {
   bvh_data bvh = build_bvh(scene);
   light_data lights = build_lights(scene);
   loading.reset();
+  warn_coarse_grid(o, params, scene, lights);
   if (int status = interrupted_before_render()) return status;
   std::string report = profile_render(scene, bvh, lights, params, o.scene + " with the " + o.sampler + " sampler");
   std::fputs(report.c_str(), stdout);
@@ -716,6 +730,7 @@ int run_compare_command(const compare_options& o) {
   cp.reference_note = o.reference_note;
   cp.out_dir = o.out;
   cp.quiet = o.render.quiet;
+  cp.grid_given = option_given(o.render, "--grid");
   return run_compare(desc, cp);
 }
 

@@ -419,6 +419,15 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   loading.reset();
   if (lights.count == 0)
     std::fprintf(stderr, "%s: warning: the scene has no emitters (the image is black)\n", params.scene_path.c_str());
+  for (sampler_kind k : params.samplers) {  // (the first sampler the regions of which come out coarse: one line)
+    sampler_params sp = rp.sampler;
+    sp.kind = k;
+    const std::string w = coarse_grid_warning(sp, rp.max_depth, int64_t(rp.width) * rp.height, scene.bounds,
+                                              int(lights.tri.size()), params.grid_given);
+    if (w.empty()) continue;
+    std::fprintf(stderr, "%s: warning: %s\n", params.scene_path.c_str(), w.c_str());
+    break;
+  }
   const std::vector<fs::path> created = make_output_dir(params.out_dir);
   // Interrupted with nothing to report (as render, which then keeps the files already there): the folders this run
   // created are removed again, since they stay empty.

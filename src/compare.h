@@ -29,6 +29,7 @@ struct compare_params {
   std::string out_dir;                 // created (one level) when missing
   error_image_params error_image;
   bool quiet = false;                  // no per-render lines on stderr
+  bool grid_given = false;             // --grid was given (for the warning about coarse regions)
 };
 
 // One render of one sampler.

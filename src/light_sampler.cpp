@@ -71,6 +71,37 @@ region_params effective_region_params(const sampler_params& params, int max_dept
   return rp;
 }
 
+std::string coarse_grid_warning(const sampler_params& params, int max_depth, int64_t pixels, const bbox3f& bounds,
+                                int triangle_lights, bool given_grid) {
+  const sampler_kind k = params.kind;
+  const region_params rp = effective_region_params(params, max_depth, pixels);
+  const bool shared = triangle_lights <= std::min(rp.max_cut, rp.shared_cut_lights);
+  // (donikian's regions serve the vertices past the first; bound's only cuts, which a shared cut makes one)
+  const bool reads = k == sampler_kind::bayes || (k == sampler_kind::bound && !shared) ||
+                     (k == sampler_kind::donikian && !shared && max_depth > 1);
+  if (!reads) return "";
+  float shortest = 0;
+  const float cell = fine_cell_side(bounds, rp.grid, &shortest);
+  const double asked = double(shortest) / std::max(1, rp.grid);
+  if (!(double(cell) > 1.01 * asked)) return "";
+  const bbox3f b = grid_bounds(bounds);
+  const float longest = max_component(extent(b)), coords = std::max(max_abs_component(b.lo), max_abs_component(b.hi));
+  char why[160], buf[768];
+  if (double(cell) > double(longest) / ((1 << 20) - 1) * 1.0001)
+    std::snprintf(why, sizeof why, "cells are no smaller than a few float ulps of coordinates %.3g from the origin",
+                  double(coords));
+  else
+    std::snprintf(why, sizeof why, "at most 2^20 cells fit along its longest side, %.3g", double(longest));
+  const std::string asker = given_grid ? "--grid " + std::to_string(rp.grid) : "the default grid";
+  std::snprintf(buf, sizeof buf,
+                "%s's regions are cells of side %.3g, %.3g times coarser than %s asks for (%d cells along the scene's "
+                "shortest side, %.3g): %s. Regions that coarse learn little of what each part of the scene sees; a "
+                "ground or backdrop far larger than the rest usually does it: leave it out, or cut it to the part in "
+                "view",
+                sampler_name(k), double(cell), double(cell) / asked, asker.c_str(), rp.grid, double(shortest), why);
+  return buf;
+}
+
 const char* sampler_name(sampler_kind kind) {
   switch (kind) {
     case sampler_kind::uniform: return "uniform";

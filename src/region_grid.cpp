@@ -122,13 +122,10 @@ bbox3f padded(const bbox3f& b) {
   return {b.lo - m, b.hi + m};
 }
 
-region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree, bool has_sun,
-                               const region_params& params) {
-  region_state s;
-  s.params = params;
-  s.has_sun = has_sun;
-  region_grid_data& g = s.grid;
-  bbox3f b = is_empty(bounds) ? bbox3f{{0, 0, 0}, {1, 1, 1}} : bounds;
+bbox3f grid_bounds(const bbox3f& bounds) { return is_empty(bounds) ? bbox3f{{0, 0, 0}, {1, 1, 1}} : bounds; }
+
+float fine_cell_side(const bbox3f& bounds, int grid, float* shortest_out) {
+  bbox3f b = grid_bounds(bounds);
   vec3f ext = extent(b);
   float longest = std::max(max_component(ext), 1e-20f);
   float shortest = std::min(ext.x, std::min(ext.y, ext.z));
@@ -138,11 +135,24 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
   // so cells shrink less than the extent from about 6e-5 of the longest side down).
   const float coords = std::max(max_abs_component(b.lo), max_abs_component(b.hi));
   if (!(shortest > 4 * FLT_EPSILON * coords)) shortest = 1e-3f * longest;
-  float cell = shortest / float(std::max(1, params.grid));
+  if (shortest_out) *shortest_out = shortest;
+  float cell = shortest / float(std::max(1, grid));
   cell = std::max(cell, longest / float(max_cells_per_axis - 1));
   // Cells of at least a few ulps of the coordinates (a 1 cm thick scene 10 m wide at x = 1e4 would have cells below
   // one: boxes of zero size whose bounds are infinite).
-  cell = std::max(cell, 4 * FLT_EPSILON * coords);
+  return std::max(cell, 4 * FLT_EPSILON * coords);
+}
+
+region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree, bool has_sun,
+                               const region_params& params) {
+  region_state s;
+  s.params = params;
+  s.has_sun = has_sun;
+  region_grid_data& g = s.grid;
+  bbox3f b = grid_bounds(bounds);
+  vec3f ext = extent(b);
+  float longest = std::max(max_component(ext), 1e-20f);
+  float cell = fine_cell_side(bounds, params.grid);
   g.origin = b.lo;
   g.cell[0] = cell;
   g.cell[1] = cell * 8;

@@ -101,6 +101,12 @@ struct region_state {
 
 constexpr uint64_t empty_region_key = ~uint64_t(0);
 
+// The bounds the grid divides (a unit box for an empty scene).
+bbox3f grid_bounds(const bbox3f& bounds);
+// The side of the fine cells over `bounds` for `grid` cells along their shortest axis (*shortest_out: that axis's
+// length, a thousandth of the longest for a flat scene). Larger than shortest / grid where the longest axis would need
+// more than 2^20 cells, or where the cells would be under a few ulps of the coordinates.
+float fine_cell_side(const bbox3f& bounds, int grid, float* shortest_out = nullptr);
 // Builds the grid over `bounds` with the root region (and, for few lights, the shared cut).
 region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree, bool has_sun,
                                const region_params& params);

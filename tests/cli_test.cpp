@@ -67,6 +67,37 @@ TEST_CASE("far geometry does not move rays off the small things near the origin"
   CHECK(d.output.find("identical") != std::string::npos);
 }
 
+TEST_CASE("regions coarser than the grid asks for are warned about", "[cli]") {
+  // A ground reaching 1e7 around a 1-unit scene: at most 2^20 cells along it make cells of 19 units, and a given --grid
+  // changed nothing without a word (a review). bound with its two lights shares one cut and reads no region.
+  tiny_scene s;
+  const std::string cmd = "render " + s.json + " --quiet -o " + (s.dir / "a.pfm");
+  const std::string warning = "regions are cells of side";
+  auto plain = run_bayeslight(cmd);
+  REQUIRE(plain.status == 0);
+  CHECK(plain.output.find(warning) == std::string::npos);
+  write_text(s.dir / "box.obj", read_text(s.dir / "box.obj") +
+                                    "usemtl floor\nv -1e7 -10 -1e7\nv 1e7 -10 -1e7\nv 1e7 -10 1e7\nv -1e7 -10 1e7\n"
+                                    "f -4 -1 -2 -3\n");
+  for (const char* sampler : {"bayes", "bound", "power"}) {
+    auto r = run_bayeslight(cmd + " --sampler " + sampler);
+    INFO(sampler << "\n" << r.output);
+    CHECK(r.status == 0);
+    CHECK((r.output.find("warning: bayes's " + warning) != std::string::npos) == (std::string(sampler) == "bayes"));
+    CHECK((r.output.find("at most 2^20 cells fit along its longest side, 2e+07") != std::string::npos) ==
+          (std::string(sampler) == "bayes"));
+  }
+  auto given = run_bayeslight(cmd + " --grid 4");
+  INFO(given.output);
+  CHECK(given.output.find("times coarser than --grid 4 asks for (4 cells along the scene's shortest side, 11)") !=
+        std::string::npos);
+  auto cmp = run_bayeslight("compare " + s.json + " --quiet --reference " + (s.dir / "a.pfm") +
+                            " --spp 1 --samplers power,bayes --out " + (s.dir / "cmp"));
+  INFO(cmp.output);
+  CHECK(cmp.status == 0);
+  CHECK(cmp.output.find("warning: bayes's " + warning) != std::string::npos);
+}
+
 TEST_CASE("lights too small for float precision where they are are warned about", "[cli]") {
   // The same room 1e6 from the origin (float steps of 1/16 there): rays leave surfaces by 1e-6 of that, 1 unit, more
   // than the 0.4-unit lamp.
