@@ -35,7 +35,7 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 23: the fallback check's first-vertex sum (path-traced renders)
 // 24: passes after bayes's fallback weigh as the first one after it
 // 25: ... with the share of the plain schedule (the passes before it kept apart)
-constexpr uint32_t version = 26;  // 26: bayes's unseen pairs (--bayes-unseen-cap)
+constexpr uint32_t version = 27;  // 27: one cut shared by all regions with the sun alone; bayes with one light is power
 
 }  // namespace
 

@@ -45,8 +45,9 @@ std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_g
 region_state make_regions(const sampler_params& params, const render_inputs& in, const light_tree_data& tree) {
   const region_params rp = effective_region_params(params, in.max_depth, int64_t(in.camera.width) * in.camera.height);
   region_state s = make_region_state(in.scene->bounds, tree, in.lights->sun != invalid_id, rp);
-  // The bound sampler reads only cuts: with one cut shared by all regions it needs no region but the root.
-  if (s.shared_cut && params.kind != sampler_kind::bayes) return s;
+  // The bound sampler reads only cuts: with one cut shared by all regions it needs no region but the root; nor does
+  // bayes with one light (bayes_sampler::one_light).
+  if (s.shared_cut && (params.kind != sampler_kind::bayes || in.lights->count <= 1)) return s;
   add_regions(s, tree, camera_region_keys(in, s.grid));
   return s;
 }
@@ -178,6 +179,8 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.power = power_sampler{make_discrete(lights.power.data(), lights.count)};
       if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
         s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);
+      s.one_light = lights.count <= 1;
+      s.fallback = s.one_light;
       s.regions = make_regions(params, in, tree);
       s.reserve_growth();
       s.add_pairs(0);

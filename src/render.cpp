@@ -285,7 +285,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
 // Whether a sampler's pmf improves with what it learns during the render (its first passes are its worst).
 template <class Sampler>
 bool adapts(const Sampler& s) {
-  if constexpr (std::is_same_v<Sampler, bayes_sampler>) return !s.frozen;
+  if constexpr (std::is_same_v<Sampler, bayes_sampler>) return !s.frozen && !s.one_light;
   else return std::is_same_v<Sampler, donikian_sampler>;
 }
 
@@ -759,6 +759,7 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
       result.pairs = b->regions.pairs;
       result.fallback_spp = b->fallback_spp;
       result.fallback_ratio = b->check_ratio;
+      result.one_light = b->one_light;
     }
     on_frame(frame, result);
     if (result.interrupted) return;

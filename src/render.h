@@ -103,6 +103,7 @@ struct render_result {
   int64_t pairs = 0;          // (region, cluster) pairs
   int fallback_spp = 0;       // bayes: spp after which it fell back to power sampling (0: it did not)
   bool fallback_earlier = false;  // ... in an earlier frame of the animation (fallback_spp counts that frame's spp)
+  bool one_light = false;      // bayes: the scene has one light, sampled as by power (bayes_sampler::one_light)
   double fallback_ratio = 0;  // bayes: the last checked estimate of power's relMSE over the learned sampler's (0: none)
   path_stats stats;
   std::vector<pass_record> log;

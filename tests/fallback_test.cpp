@@ -325,6 +325,37 @@ TEST_CASE("bayes falls back where learning cannot pay and not where it does", "[
   CHECK(off.output.find("power sampling after") == std::string::npos);
 }
 
+TEST_CASE("with one light bayes is power sampling from the start, and bound keeps one region", "[fallback]") {
+  // Nothing to choose: bayes learned for 33 spp in a sun-only scene, and its pass weights cost it 0.83x power's
+  // relMSE at equal spp; bound built a cut per region and spent two thirds of its time between passes (a review).
+  temp_dir d;
+  write_text(d / "ground.obj", "v -20 0 -20\nv 20 0 -20\nv 20 0 20\nv -20 0 20\nf 1 4 3 2\n");
+  write_text(d / "sun.json", "{\"mesh\": \"ground.obj\", \"camera\": {\"eye\": [0, 3, 8], \"target\": [0, 0, 0]},"
+                             " \"sun\": {\"direction\": [0.4, 1, 0.3], \"irradiance\": [3, 3, 3]}}");
+  write_text(d / "lamp.obj", "mtllib lamp.mtl\nv -20 0 -20\nv 20 0 -20\nv 20 0 20\nv -20 0 20\nf 1 4 3 2\n"
+                             "usemtl lamp\nv -1 2 -1\nv 1 2 -1\nv 0 2 1\nf 5 6 7\n");
+  write_text(d / "lamp.mtl", "newmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
+  write_text(d / "lamp.json", "{\"mesh\": \"lamp.obj\", \"camera\": {\"eye\": [0, 3, 8], \"target\": [0, 0, 0]}}");
+  for (const char* scene : {"sun", "lamp"})
+    for (const char* depth : {"1", "3"}) {
+      const std::string base = "render " + (d / (std::string(scene) + ".json")) +
+                               " --width 32 --height 24 --spp 24 --max-depth " + depth + " --sampler ";
+      INFO(scene << " depth " << depth);
+      auto power = run_bayeslight(base + "power -o " + (d / "power.pfm"));
+      auto bayes = run_bayeslight(base + "bayes -o " + (d / "bayes.pfm"));
+      auto bound = run_bayeslight(base + "bound -o " + (d / "bound.pfm"));
+      INFO(bayes.output << bound.output);
+      REQUIRE(power.status == 0);
+      REQUIRE(bayes.status == 0);
+      REQUIRE(bound.status == 0);
+      CHECK(read_text(d / "power.pfm") == read_text(d / "bayes.pfm"));
+      CHECK(read_text(d / "power.pfm") == read_text(d / "bound.pfm"));
+      CHECK(bayes.output.find("1 region, 1 cluster, ") != std::string::npos);
+      CHECK(bayes.output.find("one light: nothing to learn, sampled as by power") != std::string::npos);
+      CHECK(bound.output.find("1 region, 1 cluster, ") != std::string::npos);
+    }
+}
+
 TEST_CASE("the fallback check does not pair a one-spp pass with a pass of other NEE draws", "[fallback]") {
   // A review (stop 55): with --bayes-early-spp 4-7 the first one-draw pass, of one spp, was paired with the last
   // four-draw one, whose sample has a smaller variance. At 640 x 480 every checked pass is a window of its own, and a
