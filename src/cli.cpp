@@ -210,7 +210,7 @@ static void warn_coarse_grid(const render_options& o, const render_params& param
                              const light_data& lights) {
   const std::string w =
       coarse_grid_warning(params.sampler, params.max_depth, int64_t(params.width) * params.height, scene.bounds,
-                          int(lights.tri.size()), option_given(o, "--grid"));
+                          lights, option_given(o, "--grid"));
   if (!w.empty()) std::fprintf(stderr, "%s: warning: %s\n", o.scene.c_str(), w.c_str());
 }
 

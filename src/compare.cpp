@@ -422,8 +422,8 @@ int run_compare(const scene_desc& desc, const compare_params& params) {
   for (sampler_kind k : params.samplers) {  // (the first sampler the regions of which come out coarse: one line)
     sampler_params sp = rp.sampler;
     sp.kind = k;
-    const std::string w = coarse_grid_warning(sp, rp.max_depth, int64_t(rp.width) * rp.height, scene.bounds,
-                                              int(lights.tri.size()), params.grid_given);
+    const std::string w =
+        coarse_grid_warning(sp, rp.max_depth, int64_t(rp.width) * rp.height, scene.bounds, lights, params.grid_given);
     if (w.empty()) continue;
     std::fprintf(stderr, "%s: warning: %s\n", params.scene_path.c_str(), w.c_str());
     break;

@@ -73,12 +73,12 @@ region_params effective_region_params(const sampler_params& params, int max_dept
 }
 
 std::string coarse_grid_warning(const sampler_params& params, int max_depth, int64_t pixels, const bbox3f& bounds,
-                                int triangle_lights, bool given_grid) {
+                                const light_data& lights, bool given_grid) {
   const sampler_kind k = params.kind;
   const region_params rp = effective_region_params(params, max_depth, pixels);
-  const bool shared = triangle_lights <= std::min(rp.max_cut, rp.shared_cut_lights);
+  const bool shared = int(lights.tri.size()) <= std::min(rp.max_cut, rp.shared_cut_lights);
   // (donikian's regions serve the vertices past the first; bound's only cuts, which a shared cut makes one)
-  const bool reads = k == sampler_kind::bayes || (k == sampler_kind::bound && !shared) ||
+  const bool reads = (k == sampler_kind::bayes && lights.count > 1) || (k == sampler_kind::bound && !shared) ||
                      (k == sampler_kind::donikian && !shared && max_depth > 1);
   if (!reads) return "";
   float shortest = 0;

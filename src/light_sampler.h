@@ -43,10 +43,10 @@ region_params effective_region_params(const sampler_params& params, int max_dept
 
 // A warning, or "" : where a region sampler's fine cells come out coarser than its grid asks for (at most 2^20 cells
 // fit along the longest axis of `bounds`, a room on a ground reaching 1e7; or cells of a few ulps far from the
-// origin), which the regions then learn too little to serve (`triangle_lights`: a handful share one cut, and bound
-// then reads no region). `given_grid`: the grid came from --grid.
+// origin), which the regions then learn too little to serve (a handful of `lights` share one cut, and bound then reads
+// no region; bayes with one light reads none). `given_grid`: the grid came from --grid.
 std::string coarse_grid_warning(const sampler_params& params, int max_depth, int64_t pixels, const bbox3f& bounds,
-                                int triangle_lights, bool given_grid);
+                                const light_data& lights, bool given_grid);
 
 // Builds the sampler of `params.kind`; `tree` must outlive it. Region-based samplers discover the regions of the
 // camera's first hits up front (one ray per pixel centre). Throws usage_error for a kind this build lacks.

@@ -125,8 +125,7 @@ scene_data build_scene(const scene_desc& desc, float aspect) {
   {
     // A camera whose rays float cannot place to a hundredth of the view's height at its target (5 pixels of 480 rows)
     // renders a distorted image, or a black one: an eye 1e8 from the origin with a field of view of 5e-6
-    // degrees framing a 10-unit stage wrote zeros without a word (a review). Rounding of the eye's coordinates and
-    // of the ray's direction over the distance to the target.
+    // degrees framing a 10-unit stage wrote zeros without a word (a review).
     // The direction errs by the rounding of the coordinates eye and target differ in, across the view only: a target
     // on an axis through the eye gives an exact direction however near (a target 1e-6 before the eye was warned
     // about, its image that of a far target; a review). The eye's own rounding errs by an ulp of its coordinates at
