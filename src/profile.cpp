@@ -213,8 +213,9 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
   else  // the timers' cost is below the machine's noise on a render this short
     line("  timers cost: the timed render took %.1f%% less time than the plain one (noise)\n", -extra);
   if (a.regions > 0)
-    line("  sampler state: %.2f MB; %d regions, %lld (region, cluster) pairs, %.1f bytes per pair\n",
-         double(a.sampler_bytes) / (1 << 20), a.regions, (long long)a.pairs,
+    line("  sampler state: %.2f MB; %d region%s, %lld (region, cluster) pair%s, %.1f bytes per pair\n",
+         double(a.sampler_bytes) / (1 << 20), a.regions, a.regions == 1 ? "" : "s", (long long)a.pairs,
+         a.pairs == 1 ? "" : "s",
          a.pairs > 0 ? double(a.sampler_bytes) / double(a.pairs) : 0.0);
   return out;
 }
