@@ -76,7 +76,7 @@ std::string coarse_grid_warning(const sampler_params& params, int max_depth, int
                                 const light_data& lights, bool given_grid) {
   const sampler_kind k = params.kind;
   const region_params rp = effective_region_params(params, max_depth, pixels);
-  const bool shared = int(lights.tri.size()) <= std::min(rp.max_cut, rp.shared_cut_lights);
+  const bool shared = shares_one_cut(int(lights.tri.size()), lights.sun != invalid_id, rp);
   // (donikian's regions serve the vertices past the first; bound's only cuts, which a shared cut makes one)
   const bool reads = (k == sampler_kind::bayes && lights.count > 1) || (k == sampler_kind::bound && !shared) ||
                      (k == sampler_kind::donikian && !shared && max_depth > 1);

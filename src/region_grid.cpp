@@ -122,6 +122,12 @@ bbox3f padded(const bbox3f& b) {
   return {b.lo - m, b.hi + m};
 }
 
+bool shares_one_cut(int triangle_lights, bool has_sun, const region_params& params) {
+  // (The sun alone too: bound built a cut per region and took 3x power's time per NEE sample in a sun-only scene, two
+  // thirds of it between passes; a review.)
+  return (triangle_lights > 0 || has_sun) && triangle_lights <= std::min(params.max_cut, params.shared_cut_lights);
+}
+
 bbox3f grid_bounds(const bbox3f& bounds) { return is_empty(bounds) ? bbox3f{{0, 0, 0}, {1, 1, 1}} : bounds; }
 
 float fine_cell_side(const bbox3f& bounds, int grid, float* shortest_out) {
@@ -166,10 +172,8 @@ region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree
         g.dims[l][a] = cells < double(max_cells_per_axis) ? std::max(1, int(cells)) : max_cells_per_axis;
       }
   std::vector<int> all;
-  int leaves = (node_count(tree) + 1) / 2;
-  if ((node_count(tree) > 0 || has_sun) && leaves <= std::min(params.max_cut, params.shared_cut_lights)) {
-    // A handful of lights: one cut of all lights serves every region. (The sun alone too: bound built a cut per
-    // region and took 3x power's time per NEE sample in a sun-only scene, two thirds of it between passes; a review.)
+  if (shares_one_cut((node_count(tree) + 1) / 2, has_sun, params)) {
+    // A handful of lights: one cut of all lights serves every region.
     s.shared_cut = true;
     for (int n = 0; n < node_count(tree); n++)
       if (is_leaf(tree, n)) all.push_back(n);

@@ -107,6 +107,9 @@ bbox3f grid_bounds(const bbox3f& bounds);
 // length, a thousandth of the longest for a flat scene). Larger than shortest / grid where the longest axis would need
 // more than 2^20 cells, or where the cells would be under a few ulps of the coordinates.
 float fine_cell_side(const bbox3f& bounds, int grid, float* shortest_out = nullptr);
+// Whether every region shares one cut of all lights (a handful: no clustering), for `triangle_lights` emissive
+// triangles and the sun if `has_sun`.
+bool shares_one_cut(int triangle_lights, bool has_sun, const region_params& params);
 // Builds the grid over `bounds` with the root region (and, for few lights, the shared cut).
 region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree, bool has_sun,
                                const region_params& params);
