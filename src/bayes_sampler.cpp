@@ -333,6 +333,13 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
     double q = power.pmf({}, e.choice.light);
     double with_power = a == 0 ? 0.0 : q > 0 ? a * a * p / q : HUGE_VAL;
     px_delta[size_t(e.pixel)] += with_power - double(e.added_total) * e.added_total;
+    if (!px_delta_bvh.empty()) {  // the same with the bvh sampler's probability of the light at the point
+      bvh_sampler::context b;
+      bvh.prepare_at(b, e.context->p, e.context->n);
+      double qb = bvh.pmf(b, e.choice.light);
+      double with_bvh = a == 0 ? 0.0 : qb > 0 ? a * a * p / qb : HUGE_VAL;
+      px_delta_bvh[size_t(e.pixel)] += with_bvh - double(e.added_total) * e.added_total;
+    }
     if (e.first_vertex && !px_first.empty()) px_first[size_t(e.pixel)] += with_power;
   }
   const cut_context& ctx = *e.context;
@@ -563,11 +570,12 @@ void bayes_sampler::flush_check(const row_state& row) const {
 }
 
 void bayes_sampler::restart_check() {
-  px_var = px_delta = px_first = {};
+  px_var = px_delta = px_first = px_delta_bvh = {};
   px_prev = px_cur = {};
   fallback_votes = 0;
   check_done = check_pairs = false;
-  window_var = window_delta = window_samples = window_first = 0;
+  window_var = window_delta = window_samples = window_first = window_delta_bvh = 0;
+  bvh_windows = 0;
 }
 
 double bayes_sampler::stratified_factor(double power_var, double first) const {
@@ -596,8 +604,8 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     // Summed over the pass's samples with relMSE's weights 1 / (m^2 + 0.01), m the pixel's mean luminance with this
     // pass included (a pixel whose earlier samples missed a bright edge would otherwise weigh as black): V, the
     // learned estimator's variance, and V + D, power sampling's (D: the NEE events' second moments, see record).
-    double var = 0, delta = 0, first = 0;
-    const bool firsts = px_first.size() == n;
+    double var = 0, delta = 0, first = 0, delta_bvh = 0;
+    const bool firsts = px_first.size() == n, bvhs = px_delta_bvh.size() == n;
     for (size_t i = 0; i < n; i++) {  // in pixel order
       vec3f m = {float(film[3 * i] / weight), float(film[3 * i + 1] / weight), float(film[3 * i + 2] / weight)};
       float y = luminance(m);
@@ -605,9 +613,11 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
       var += w * px_var[i];
       delta += w * px_delta[i];
       if (firsts) first += w * px_first[i];
+      if (bvhs) delta_bvh += w * px_delta_bvh[i];
     }
     window_var += var;
     window_delta += delta;
+    window_delta_bvh += delta_bvh;
     window_first += first;
     window_samples += double(n) * pass_spp;
   }
@@ -617,14 +627,27 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     check_ratio = valid ? (window_var + window_delta) / window_var : 0.0;
     const double threshold = params.fallback_ratio * stratified_factor(window_var + window_delta, window_first);
     bool below = valid && window_var + window_delta < threshold * window_var;
-    fallback_votes = below ? fallback_votes + 1 : 0;
-    window_var = window_delta = window_samples = window_first = 0;
+    // The bvh sampler (in the first max_bvh_windows windows) against its own threshold, without the stratified factor:
+    // it is taken only where it beats learning even per independent sample, whatever stratification would add to
+    // that. An infinite estimate (a light bayes drew with a contribution that bvh could never choose) or a NaN one
+    // never votes for it.
+    const double t_bvh = params.fallback_bvh_ratio;
+    const bool bvh_checked = checks_bvh(), bvh = bvh_checked && valid;
+    if (bvh) check_ratio_bvh = (window_var + window_delta_bvh) / window_var;
+    if (bvh_checked) bvh_windows++;
+    const bool below_bvh = bvh && check_ratio_bvh < t_bvh;
+    fallback_votes = below || below_bvh ? fallback_votes + 1 : 0;
+    window_var = window_delta = window_samples = window_first = window_delta_bvh = 0;
     fallback = fallback_votes >= 2;
-    if (fallback) fallback_spp = spp;
-    check_done = valid && check_ratio >= 2 * threshold;
+    if (fallback) {
+      fallback_spp = spp;
+      fallback_bvh = below_bvh && (!below || check_ratio_bvh * bvh_fallback_cost < check_ratio);
+    }
+    check_done = valid && check_ratio >= 2 * threshold && (!bvh_checked || !(check_ratio_bvh < 2 * t_bvh));
     if (fallback || check_done) {
       px_var = {};
       px_delta = {};
+      px_delta_bvh = {};
       px_first = {};
       px_prev = {};
       px_cur = {};
@@ -633,6 +656,11 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
   }
   px_var.assign(n, 0.0);
   px_delta.assign(n, 0.0);
+  if (checks_bvh()) {
+    px_delta_bvh.assign(n, 0.0);
+  } else {
+    px_delta_bvh = {};
+  }
   if (params.path_traced) px_first.assign(n, 0.0);
   if (pass_spp == 1 && px_prev.size() != n) px_prev.assign(n, NAN);
   if (pass_spp == 1 && px_cur.size() != n) px_cur.assign(n, NAN);

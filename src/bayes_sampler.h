@@ -7,6 +7,7 @@
 
 #include "bayes_stats.h"
 #include "cut_sampling.h"
+#include "bvh_sampler.h"
 #include "simple_samplers.h"
 
 #include <vector>
@@ -40,19 +41,35 @@ struct bayes_sampler {
   std::vector<int> child_link;
   size_t parent_pairs = 0;  // pairs with a list of children (coarse pairs whose fine regions exist)
 
-  // Fallback (bayes_params::fallback_ratio): once on, lights are chosen by power and nothing more is learned.
+  // Fallback (bayes_params::fallback_ratio, fallback_bvh_ratio): once on, lights are chosen by power (or, with
+  // fallback_bvh, by the bvh sampler) and nothing more is learned.
   power_sampler power;
+  bvh_sampler bvh;          // (its tree unset: no bvh alternative is checked)
   bool fallback = false;
+  bool fallback_bvh = false;  // the fallback chose the bvh sampler
+  // bvh's NEE sample costs about this many of power's (the Cornell box, direct, equal time: 660 against 976 spp): where
+  // both fall below their thresholds, bvh is taken only where its estimate is this much below power's.
+  static constexpr double bvh_fallback_cost = 1.5;
   int fallback_votes = 0;  // consecutive check windows whose ratio was below the threshold
   double window_var = 0, window_delta = 0, window_samples = 0;  // the current window's sums (see check_fallback)
   double window_first = 0;  // ... and of power sampling's second moment at first vertices (path-traced renders)
   int fallback_spp = 0;    // spp rendered when it fell back (reports)
   bool check_done = false; // a window found learning to pay by at least twice the threshold: no more checks
   double check_ratio = 0;  // the last window's estimated relMSE ratio, power over learned (0: none yet)
+  double check_ratio_bvh = 0;  // ... bvh over learned (0: none yet or not checked)
+  double window_delta_bvh = 0;  // the current window's sum of bvh's second-moment change (as window_delta's)
   // Per pixel, for the fallback check of the current pass (empty while it does not run): the sum over its samples
   // of their luminance's variance, and of its NEE events' second-moment change under power sampling. Each pixel is
   // written by the one task rendering its row (no races), and summed in pixel order.
   mutable std::vector<double> px_var, px_delta;  // (double: squares of radiance beyond float's range)
+  mutable std::vector<double> px_delta_bvh;      // the same change under bvh sampling (empty: bvh is not checked)
+  // bvh's probability costs a descent of the tree per NEE event (up to a third of a render's time with 128 lights):
+  // it is checked in the first max_bvh_windows windows only, where a fallback gains most.
+  static constexpr int max_bvh_windows = 4;
+  int bvh_windows = 0;  // windows that checked bvh so far
+  bool checks_bvh() const {
+    return bvh.tree != nullptr && params.fallback_bvh_ratio > 0 && bvh_windows < max_bvh_windows;
+  }
   // Path-traced renders: per pixel, the sum over its first vertices' NEE events of their second moment under power
   // sampling (what stratifying the first vertex can make smaller; empty in direct renders, where that is every event).
   mutable std::vector<double> px_first;

@@ -66,6 +66,11 @@ struct bayes_params {
                                  // cost (bayes costs 1.4-2.6x power's time per sample on the data/ scenes); 0: never
                                  // (1.25 until the lamps' control variates raised the Cornell box's estimate to a
                                  // hair under 2.5: README)
+  double fallback_bvh_ratio = 1;  // fall back to the bvh sampler instead where its estimated relMSE per sample is
+                                  // below this many times the learned one's (two windows in a row, as above), and
+                                  // below power's estimate over bvh_fallback_cost: many lights that every point sees
+                                  // alike, in clusters the learned model cannot split (64 small lamps over a floor,
+                                  // path traced, where bvh had 25x bayes's relMSE at equal spp); 0: never
   double fallback_stratified = 2;  // the threshold's factor when the first vertex is stratified (the default): the
                                    // check estimates both sides as if samples were independent, but stratification
                                    // helps a fixed choice more (the Cornell box, direct: estimated 1.86x, about 1.3x

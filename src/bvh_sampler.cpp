@@ -8,11 +8,11 @@ float sun_importance(const light_data& lights, vec3f n, float sun_sin, float sun
   return luminance(lights.sun_irradiance) * receiver_cos_bound(n, lights.sun_dir, sun_sin, sun_cos);
 }
 
-void bvh_sampler::prepare(context& ctx, const shade_point& sp) const {
-  ctx.p = sp.p;
-  ctx.n = sp.n;
-  float is = sun_importance(*lights, sp.n, sun_sin, sun_cos);
-  float it = node_count(*tree) > 0 ? node_importance(*tree, 0, sp.p, sp.n) : 0.0f;
+void bvh_sampler::prepare_at(context& ctx, vec3f p, vec3f n) const {
+  ctx.p = p;
+  ctx.n = n;
+  float is = sun_importance(*lights, n, sun_sin, sun_cos);
+  float it = node_count(*tree) > 0 ? node_importance(*tree, 0, p, n) : 0.0f;
   ctx.p_sun = is > 0 ? left_share(is, it) : 0.0;
   ctx.p_tree = it > 0 ? 1 - ctx.p_sun : 0.0;
 }

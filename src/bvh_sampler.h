@@ -24,7 +24,8 @@ struct bvh_sampler {
   float sun_sin = 0, sun_cos = 1;  // sun disk half-angle
 
   void locate(context&, const shade_point&) const {}
-  void prepare(context& ctx, const shade_point& sp) const;
+  void prepare(context& ctx, const shade_point& sp) const { prepare_at(ctx, sp.p, sp.n); }
+  void prepare_at(context& ctx, vec3f p, vec3f n) const;
   light_choice sample(const context& ctx, double u, double) const;
   float pmf(const context& ctx, int light) const;
   void end_pass() {}

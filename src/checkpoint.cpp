@@ -35,7 +35,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 23: the fallback check's first-vertex sum (path-traced renders)
 // 24: passes after bayes's fallback weigh as the first one after it
 // 25: ... with the share of the plain schedule (the passes before it kept apart)
-constexpr uint32_t version = 27;  // 27: one cut shared by all regions with the sun alone; bayes with one light is power
+// 27: one cut shared by all regions with the sun alone; bayes with one light is power
+constexpr uint32_t version = 28;  // 28: bayes's fallback check also weighs the bvh sampler, and can fall back to it
 
 }  // namespace
 
@@ -274,6 +275,8 @@ void write_sampler(writer& w, const light_sampler& ls) {
     w.value(int32_t(b->fallback_spp));
     w.value(b->check_ratio);
     w.value(b->window_var), w.value(b->window_delta), w.value(b->window_samples), w.value(b->window_first);
+    w.value(uint8_t(b->fallback_bvh)), w.value(b->check_ratio_bvh), w.value(b->window_delta_bvh);
+    w.value(int32_t(b->bvh_windows));
     w.value(uint8_t(b->check_pairs));
     w.value(uint8_t(b->check_done));
     w.value(uint64_t(b->px_var.size()));
@@ -323,17 +326,22 @@ void read_sampler(reader& r, light_sampler& ls, size_t pixels) {
     b->check_ratio = r.value<double>();
     b->window_var = r.value<double>(), b->window_delta = r.value<double>(), b->window_samples = r.value<double>();
     b->window_first = r.value<double>();
+    b->fallback_bvh = r.value<uint8_t>() != 0;
+    b->check_ratio_bvh = r.value<double>(), b->window_delta_bvh = r.value<double>();
+    b->bvh_windows = r.value<int32_t>();
     b->check_pairs = r.value<uint8_t>() != 0;
     b->check_done = r.value<uint8_t>() != 0;
     uint64_t checked = r.value<uint64_t>();
     b->px_prev = r.column<float>();
     if (b->fallback_votes < 0 || b->fallback_spp < 0 || !std::isfinite(b->check_ratio) ||
         (checked != 0 && checked != pixels) || !(b->window_samples >= 0) || std::isnan(b->window_var) ||
-        std::isnan(b->window_delta) || std::isnan(b->window_first) ||
+        std::isnan(b->window_delta) || std::isnan(b->window_first) || std::isnan(b->check_ratio_bvh) ||
+        std::isnan(b->window_delta_bvh) || (b->fallback_bvh && !b->fallback) || b->bvh_windows < 0 ||
         (!b->px_prev.empty() && b->px_prev.size() != checked))
       r.fail("fallback check");
     b->px_var.assign(size_t(checked), 0.0);
     b->px_delta.assign(size_t(checked), 0.0);
+    if (b->checks_bvh()) b->px_delta_bvh.assign(size_t(checked), 0.0);
     if (b->params.path_traced) b->px_first.assign(size_t(checked), 0.0);
     b->px_cur.assign(b->px_prev.size(), NAN);
     // Prior means and coefficients are functions of the regions and statistics: recomputed (bit for bit the same);
@@ -469,6 +477,7 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
     h.value(b.oracle_spp), h.value(b.refold_tolerance), h.value(b.orientation), h.value(b.mean_hierarchy);
     h.value(b.fallback_ratio), h.value(b.fallback_window), h.value(b.fallback_stratified), h.value(b.bsdf_factor);
     h.value(b.cv_every_vertex);
+    h.value(b.fallback_ratio > 0 ? b.fallback_bvh_ratio : 0.0);
     h.value(b.prior && b.region_prior ? b.unseen_cap : 0.0);
     // The early draws, where they can apply (direct illumination; one draw or no early spp: none).
     const bool early = p.max_depth == 1 && b.early_draws > std::max(1, p.light_samples) && b.early_spp > 0;

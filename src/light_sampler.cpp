@@ -177,6 +177,7 @@ light_sampler make_light_sampler(const sampler_params& params, const render_inpu
       s.params.stratified = in.stratify;
       s.params.path_traced = in.max_depth > 1;
       s.power = power_sampler{make_discrete(lights.power.data(), lights.count)};
+      s.bvh.tree = &tree, s.bvh.lights = &lights, s.bvh.sun_sin = sun_sin, s.bvh.sun_cos = sun_cos;
       if (lights.sun != invalid_id && luminance(lights.sun_irradiance) > 0)
         s.sun_color = lights.sun_irradiance / luminance(lights.sun_irradiance);
       s.one_light = lights.count <= 1;
@@ -207,7 +208,8 @@ size_t sampler_memory_bytes(const light_sampler& s) {
            bytes_of(st.k_folded) + bytes_of(st.gw) + bytes_of(st.gw_cv) + bytes_of(st.gcv) + bytes_of(st.gcol) +
            bytes_of(st.gtot) + bytes_of(st.gtot_cv) + bytes_of(st.unseen) + bytes_of(st.gunseen) + bytes_of(st.mw) +
            bytes_of(st.mw_cv) + bytes_of(b->child_link) +
-           bytes_of(b->px_var) + bytes_of(b->px_delta) + bytes_of(b->px_first) + bytes_of(b->px_prev) +
+           bytes_of(b->px_var) + bytes_of(b->px_delta) + bytes_of(b->px_delta_bvh) + bytes_of(b->px_first) +
+           bytes_of(b->px_prev) +
            bytes_of(b->px_cur);
   }
   if (auto* d = std::get_if<donikian_sampler>(&s))

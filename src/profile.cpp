@@ -150,11 +150,14 @@ std::string profile_render(const scene_data& scene, const bvh_data& bvh, const l
        double(st.camera_rays) * 1e-6, double(st.shadow_rays) * 1e-6, double(st.bounce_rays) * 1e-6);
   line("  timed render: the same %d spp, %.3f s; stages below per %s of it%s\n", b.spp, b.seconds, unit,
        per_ray ? " (the render took no NEE sample)" : "");
-  // bayes's passes after a fallback choose lights by power (no region, no learning): the stages mix both.
-  if (b.fallback_spp > 0)
-    line("  bayes fell back to power sampling after %d spp (learning was estimated to cut relMSE per sample only "
-         "%.2fx): the stages below mix %d spp of bayes with %d of power sampling\n",
-         b.fallback_spp, b.fallback_ratio, b.fallback_spp, b.spp - b.fallback_spp);
+  // bayes's passes after a fallback choose lights by power or bvh (no region, no learning): the stages mix both.
+  if (b.fallback_spp > 0) {
+    const char* to = b.fallback_bvh ? "bvh" : "power";
+    line("  bayes fell back to %s sampling after %d spp (learning was estimated to cut relMSE per sample only "
+         "%.2fx): the stages below mix %d spp of bayes with %d of %s sampling\n",
+         to, b.fallback_spp, b.fallback_bvh ? b.fallback_ratio_bvh : b.fallback_ratio, b.fallback_spp,
+         b.spp - b.fallback_spp, to);
+  }
   // Stage times are per-thread cycles; in wall time per NEE sample they are divided by the thread count.
   double pass_wall = b.seconds - b.learn_seconds;
   double staged = 0;

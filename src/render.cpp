@@ -448,9 +448,10 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
                    ? run_pass<true>(pin, s, s0, s1, pass_sum, rows, arena, progress, raise, extend, gathering)
                    : run_pass<false>(pin, s, s0, s1, pass_sum, rows, arena, progress, raise, extend, gathering);
       };
-      // A bayes sampler that fell back runs its passes as the power sampler itself: the hot path has none of its
-      // code.
-      if constexpr (std::is_same_v<Sampler, bayes_sampler>) return sampler.fallback ? run(sampler.power) : run(sampler);
+      // A bayes sampler that fell back runs its passes as the power (or bvh) sampler itself: the hot path has none of
+      // its code.
+      if constexpr (std::is_same_v<Sampler, bayes_sampler>)
+        return !sampler.fallback ? run(sampler) : sampler.fallback_bvh ? run(sampler.bvh) : run(sampler.power);
       else return run(sampler);
     };
     bool complete = run_samples(done, done + count, false);
@@ -759,6 +760,8 @@ void render_frames(const scene_data& scene, const bvh_data& bvh, light_data& lig
       result.pairs = b->regions.pairs;
       result.fallback_spp = b->fallback_spp;
       result.fallback_ratio = b->check_ratio;
+      result.fallback_bvh = b->fallback_bvh;
+      result.fallback_ratio_bvh = b->check_ratio_bvh;
       result.one_light = b->one_light;
     }
     on_frame(frame, result);

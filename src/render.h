@@ -101,10 +101,12 @@ struct render_result {
   uint64_t profile_cycles[prof_count] = {};  // time-stamp counter cycles per stage (profile renders only)
   int regions = 0;            // regions of a region-based sampler
   int64_t pairs = 0;          // (region, cluster) pairs
-  int fallback_spp = 0;       // bayes: spp after which it fell back to power sampling (0: it did not)
+  int fallback_spp = 0;       // bayes: spp after which it fell back to power (or bvh) sampling (0: it did not)
+  bool fallback_bvh = false;  // ... to the bvh sampler
   bool fallback_earlier = false;  // ... in an earlier frame of the animation (fallback_spp counts that frame's spp)
   bool one_light = false;      // bayes: the scene has one light, sampled as by power (bayes_sampler::one_light)
   double fallback_ratio = 0;  // bayes: the last checked estimate of power's relMSE over the learned sampler's (0: none)
+  double fallback_ratio_bvh = 0;  // ... and of bvh's (0: none)
   path_stats stats;
   std::vector<pass_record> log;
 };

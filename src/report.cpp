@@ -68,19 +68,25 @@ std::string render_summary(const render_result& r, const std::vector<std::string
   if (r.one_light) {
     s += "; one light: nothing to learn, sampled as by power";
   } else if (r.fallback_spp > 0 && r.fallback_earlier) {
-    std::snprintf(buf, sizeof buf, "; power sampling since an earlier frame (after %d spp of it)", r.fallback_spp);
+    std::snprintf(buf, sizeof buf, "; %s sampling since an earlier frame (after %d spp of it)",
+                  r.fallback_bvh ? "bvh" : "power", r.fallback_spp);
     s += buf;
   } else if (r.fallback_spp > 0) {
-    std::snprintf(buf, sizeof buf, "; power sampling after %d spp (learning was estimated to cut relMSE per sample only %.2fx)",
-                  r.fallback_spp, r.fallback_ratio);
+    std::snprintf(buf, sizeof buf, "; %s sampling after %d spp (learning was estimated to cut relMSE per sample only %.2fx)",
+                  r.fallback_bvh ? "bvh" : "power", r.fallback_spp,
+                  r.fallback_bvh ? r.fallback_ratio_bvh : r.fallback_ratio);
     s += buf;
   } else if (r.fallback_ratio > 0) {
     // (Against independent samples: power's own are stratified over the render, which can gain it far more where
     // every light is seen alike, a lamp in 450 triangles 60x; README, Fallback.)
     std::snprintf(buf, sizeof buf,
-                  "; learning estimated to cut relMSE per sample %.3gx against power sampling with independent samples",
-                  r.fallback_ratio);
+                  "; learning estimated to cut relMSE per sample %.3gx against power sampling", r.fallback_ratio);
     s += buf;
+    if (r.fallback_ratio_bvh > 0) {
+      std::snprintf(buf, sizeof buf, " and %.3gx against bvh", r.fallback_ratio_bvh);
+      s += buf;
+    }
+    s += ", with independent samples";
   }
   if (r.setup_seconds >= 0.01) {
     std::snprintf(buf, sizeof buf, "; set-up %.2f s (light tree, regions)", r.setup_seconds);
