@@ -333,7 +333,8 @@ void bayes_sampler::record(row_state& row, const nee_event<context>& e) const {
     double q = power.pmf({}, e.choice.light);
     double with_power = a == 0 ? 0.0 : q > 0 ? a * a * p / q : HUGE_VAL;
     px_delta[size_t(e.pixel)] += with_power - double(e.added_total) * e.added_total;
-    if (!px_delta_bvh.empty()) {  // the same with the bvh sampler's probability of the light at the point
+    // The same with the bvh sampler's probability of the light at the point (at the pixels it checks).
+    if (!px_delta_bvh.empty() && e.pixel % bvh_check_stride == 0) {
       bvh_sampler::context b;
       bvh.prepare_at(b, e.context->p, e.context->n);
       double qb = bvh.pmf(b, e.choice.light);
@@ -574,7 +575,7 @@ void bayes_sampler::restart_check() {
   px_prev = px_cur = {};
   fallback_votes = 0;
   check_done = check_pairs = false;
-  window_var = window_delta = window_samples = window_first = window_delta_bvh = 0;
+  window_var = window_delta = window_samples = window_first = window_var_bvh = window_delta_bvh = 0;
   bvh_windows = 0;
 }
 
@@ -604,7 +605,7 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     // Summed over the pass's samples with relMSE's weights 1 / (m^2 + 0.01), m the pixel's mean luminance with this
     // pass included (a pixel whose earlier samples missed a bright edge would otherwise weigh as black): V, the
     // learned estimator's variance, and V + D, power sampling's (D: the NEE events' second moments, see record).
-    double var = 0, delta = 0, first = 0, delta_bvh = 0;
+    double var = 0, delta = 0, first = 0, var_bvh = 0, delta_bvh = 0;
     const bool firsts = px_first.size() == n, bvhs = px_delta_bvh.size() == n;
     for (size_t i = 0; i < n; i++) {  // in pixel order
       vec3f m = {float(film[3 * i] / weight), float(film[3 * i + 1] / weight), float(film[3 * i + 2] / weight)};
@@ -613,10 +614,11 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
       var += w * px_var[i];
       delta += w * px_delta[i];
       if (firsts) first += w * px_first[i];
-      if (bvhs) delta_bvh += w * px_delta_bvh[i];
+      if (bvhs && i % bvh_check_stride == 0) var_bvh += w * px_var[i], delta_bvh += w * px_delta_bvh[i];
     }
     window_var += var;
     window_delta += delta;
+    window_var_bvh += var_bvh;
     window_delta_bvh += delta_bvh;
     window_first += first;
     window_samples += double(n) * pass_spp;
@@ -632,18 +634,19 @@ void bayes_sampler::check_fallback(const std::vector<row_state>& rows, const std
     // that. An infinite estimate (a light bayes drew with a contribution that bvh could never choose) or a NaN one
     // never votes for it.
     const double t_bvh = params.fallback_bvh_ratio;
-    const bool bvh_checked = checks_bvh(), bvh = bvh_checked && valid;
-    if (bvh) check_ratio_bvh = (window_var + window_delta_bvh) / window_var;
+    const bool bvh_checked = checks_bvh();
+    const bool bvh = bvh_checked && window_var_bvh > 0 && std::isfinite(window_var_bvh) && !std::isnan(window_delta_bvh);
+    if (bvh) check_ratio_bvh = (window_var_bvh + window_delta_bvh) / window_var_bvh;
     if (bvh_checked) bvh_windows++;
     const bool below_bvh = bvh && check_ratio_bvh < t_bvh;
     fallback_votes = below || below_bvh ? fallback_votes + 1 : 0;
-    window_var = window_delta = window_samples = window_first = window_delta_bvh = 0;
+    window_var = window_delta = window_samples = window_first = window_var_bvh = window_delta_bvh = 0;
     fallback = fallback_votes >= 2;
     if (fallback) {
       fallback_spp = spp;
-      fallback_bvh = below_bvh && (!below || check_ratio_bvh * bvh_fallback_cost < check_ratio);
+      fallback_bvh = below_bvh && !below;
     }
-    check_done = valid && check_ratio >= 2 * threshold && (!bvh_checked || !(check_ratio_bvh < 2 * t_bvh));
+    check_done = valid && check_ratio >= 2 * threshold && (!bvh_checked || (bvh && !(check_ratio_bvh < 2 * t_bvh)));
     if (fallback || check_done) {
       px_var = {};
       px_delta = {};

@@ -46,10 +46,11 @@ struct bayes_sampler {
   power_sampler power;
   bvh_sampler bvh;          // (its tree unset: no bvh alternative is checked)
   bool fallback = false;
-  bool fallback_bvh = false;  // the fallback chose the bvh sampler
-  // bvh's NEE sample costs about this many of power's (the Cornell box, direct, equal time: 660 against 976 spp): where
-  // both fall below their thresholds, bvh is taken only where its estimate is this much below power's.
-  static constexpr double bvh_fallback_cost = 1.5;
+  // The fallback chose the bvh sampler: its window voted for bvh and not for power. Where both vote, power is taken:
+  // it costs half of bvh's time per sample, and stratification gains it more where every light is seen alike (a lamp
+  // in 128 triangles, path traced, 3 s: falling back to power 7.3e-6 at 1195 spp, to bvh 1.05e-5 at 580, though the
+  // estimates said power 2.7x and bvh 0.39x learning's error per sample).
+  bool fallback_bvh = false;
   int fallback_votes = 0;  // consecutive check windows whose ratio was below the threshold
   double window_var = 0, window_delta = 0, window_samples = 0;  // the current window's sums (see check_fallback)
   double window_first = 0;  // ... and of power sampling's second moment at first vertices (path-traced renders)
@@ -57,15 +58,19 @@ struct bayes_sampler {
   bool check_done = false; // a window found learning to pay by at least twice the threshold: no more checks
   double check_ratio = 0;  // the last window's estimated relMSE ratio, power over learned (0: none yet)
   double check_ratio_bvh = 0;  // ... bvh over learned (0: none yet or not checked)
-  double window_delta_bvh = 0;  // the current window's sum of bvh's second-moment change (as window_delta's)
+  // The current window's sums for bvh, over the pixels it checks (bvh_check_stride): the learned estimator's variance,
+  // and bvh's second-moment change (as window_var's and window_delta's).
+  double window_var_bvh = 0, window_delta_bvh = 0;
   // Per pixel, for the fallback check of the current pass (empty while it does not run): the sum over its samples
   // of their luminance's variance, and of its NEE events' second-moment change under power sampling. Each pixel is
   // written by the one task rendering its row (no races), and summed in pixel order.
   mutable std::vector<double> px_var, px_delta;  // (double: squares of radiance beyond float's range)
   mutable std::vector<double> px_delta_bvh;      // the same change under bvh sampling (empty: bvh is not checked)
-  // bvh's probability costs a descent of the tree per NEE event (up to a third of a render's time with 128 lights):
-  // it is checked in the first max_bvh_windows windows only, where a fallback gains most.
+  // bvh's probability costs a descent of the tree per NEE event (130 ns a sample under 128 lights, 70 in the hall): it
+  // is checked in the first max_bvh_windows windows only, where a fallback gains most, and at every bvh_check_stride-th
+  // pixel only (a 320 x 240 window then holds 32768 samples' events).
   static constexpr int max_bvh_windows = 4;
+  static constexpr int bvh_check_stride = 8;
   int bvh_windows = 0;  // windows that checked bvh so far
   bool checks_bvh() const {
     return bvh.tree != nullptr && params.fallback_bvh_ratio > 0 && bvh_windows < max_bvh_windows;

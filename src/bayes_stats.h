@@ -67,10 +67,10 @@ struct bayes_params {
                                  // (1.25 until the lamps' control variates raised the Cornell box's estimate to a
                                  // hair under 2.5: README)
   double fallback_bvh_ratio = 1;  // fall back to the bvh sampler instead where its estimated relMSE per sample is
-                                  // below this many times the learned one's (two windows in a row, as above), and
-                                  // below power's estimate over bvh_fallback_cost: many lights that every point sees
-                                  // alike, in clusters the learned model cannot split (64 small lamps over a floor,
-                                  // path traced, where bvh had 25x bayes's relMSE at equal spp); 0: never
+                                  // below this many times the learned one's and power's is not below its threshold
+                                  // (two windows in a row, as above): many lights that every point sees alike, in
+                                  // clusters the learned model cannot split (64 small lamps over a floor, path
+                                  // traced, where bvh had 1/25 of bayes's relMSE at equal spp); 0: never
   double fallback_stratified = 2;  // the threshold's factor when the first vertex is stratified (the default): the
                                    // check estimates both sides as if samples were independent, but stratification
                                    // helps a fixed choice more (the Cornell box, direct: estimated 1.86x, about 1.3x

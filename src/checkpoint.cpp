@@ -275,7 +275,8 @@ void write_sampler(writer& w, const light_sampler& ls) {
     w.value(int32_t(b->fallback_spp));
     w.value(b->check_ratio);
     w.value(b->window_var), w.value(b->window_delta), w.value(b->window_samples), w.value(b->window_first);
-    w.value(uint8_t(b->fallback_bvh)), w.value(b->check_ratio_bvh), w.value(b->window_delta_bvh);
+    w.value(uint8_t(b->fallback_bvh)), w.value(b->check_ratio_bvh), w.value(b->window_var_bvh);
+    w.value(b->window_delta_bvh);
     w.value(int32_t(b->bvh_windows));
     w.value(uint8_t(b->check_pairs));
     w.value(uint8_t(b->check_done));
@@ -327,7 +328,8 @@ void read_sampler(reader& r, light_sampler& ls, size_t pixels) {
     b->window_var = r.value<double>(), b->window_delta = r.value<double>(), b->window_samples = r.value<double>();
     b->window_first = r.value<double>();
     b->fallback_bvh = r.value<uint8_t>() != 0;
-    b->check_ratio_bvh = r.value<double>(), b->window_delta_bvh = r.value<double>();
+    b->check_ratio_bvh = r.value<double>(), b->window_var_bvh = r.value<double>();
+    b->window_delta_bvh = r.value<double>();
     b->bvh_windows = r.value<int32_t>();
     b->check_pairs = r.value<uint8_t>() != 0;
     b->check_done = r.value<uint8_t>() != 0;
@@ -336,7 +338,8 @@ void read_sampler(reader& r, light_sampler& ls, size_t pixels) {
     if (b->fallback_votes < 0 || b->fallback_spp < 0 || !std::isfinite(b->check_ratio) ||
         (checked != 0 && checked != pixels) || !(b->window_samples >= 0) || std::isnan(b->window_var) ||
         std::isnan(b->window_delta) || std::isnan(b->window_first) || std::isnan(b->check_ratio_bvh) ||
-        std::isnan(b->window_delta_bvh) || (b->fallback_bvh && !b->fallback) || b->bvh_windows < 0 ||
+        std::isnan(b->window_var_bvh) || std::isnan(b->window_delta_bvh) || (b->fallback_bvh && !b->fallback) ||
+        b->bvh_windows < 0 ||
         (!b->px_prev.empty() && b->px_prev.size() != checked))
       r.fail("fallback check");
     b->px_var.assign(size_t(checked), 0.0);

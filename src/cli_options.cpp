@@ -190,9 +190,9 @@ void add_render_options(CLI::App* r, render_options& o) {
       ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-bvh-fallback-ratio", o.bayes.fallback_bvh_ratio,
                 "The same check falls back to the bvh sampler instead where its estimated relMSE per sample is below "
-                "this many times the learned sampler's (no factor for stratification), and below power's estimate "
-                "over 1.5, bvh's cost per sample: many lights every point sees alike, in clusters learning cannot "
-                "split (default 1; 0 = never; off with --bayes-fallback-ratio 0)")
+                "this many times the learned sampler's (no factor for stratification) and power's is not below its "
+                "own threshold: many lights every point sees alike, in clusters learning cannot split (default 1; 0 = "
+                "never; off with --bayes-fallback-ratio 0)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number)->group(bg);
   r->add_option("--bayes-early-draws", o.bayes.early_draws,
                 "Direct illumination: NEE draws per camera sample (at least --light-samples) in the first "
