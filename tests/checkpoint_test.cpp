@@ -123,12 +123,11 @@ TEST_CASE("a render resumed after bayes fell back continues its stratified set",
                      " --sampler bayes --width 40 --height 30 --spp 677 --quiet";
   auto full = run_bayeslight(args + " -o " + (d / "full.pfm") + " --log " + (d / "log.csv"));
   REQUIRE(full.status == 0);
-  std::string ck = d / "ck.bin";
-  CHECK(run_bayeslight(args + " -o " + (d / "part.pfm") + " --checkpoint " + ck + " --stop-after-passes 29").status == 130);
-  auto resumed = run_bayeslight(args + " -o " + (d / "resumed.pfm") + " --resume " + ck);
-  INFO(resumed.output);
-  REQUIRE(resumed.status == 0);
-  CHECK(read_file(d / "resumed.pfm") == read_file(d / "full.pfm"));
+  resume_run r = stop_and_resume(d, args, 29, d / "full.pfm");
+  INFO(r.resumed.output);
+  CHECK(r.stopped == 130);
+  REQUIRE(r.resumed.status == 0);
+  CHECK(r.same);
   // The fallback did happen before the interruption (else the test would not test the set's start).
   auto check = run_bayeslight("render " + source_path("data/cornell/path.json") +
                               " --sampler bayes --width 40 --height 30 --spp 549 -o " + (d / "c.pfm"));

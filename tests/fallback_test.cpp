@@ -439,12 +439,11 @@ TEST_CASE("bayes falls back to bvh where many lights are seen alike, determinist
   REQUIRE(one.status == 0);
   CHECK(read_file(d / "one.pfm") == read_file(d / "full.pfm"));
   // Resumed after pass 16 (40 spp), past the fallback at the end of pass 15: the bvh passes' stratified set goes on.
-  std::string ck = d / "ck.bin";
-  CHECK(run_bayeslight(args + " -o " + (d / "part.pfm") + " --checkpoint " + ck + " --stop-after-passes 16").status == 130);
-  auto resumed = run_bayeslight(args + " -o " + (d / "resumed.pfm") + " --resume " + ck);
-  INFO(resumed.output);
-  REQUIRE(resumed.status == 0);
-  CHECK(read_file(d / "resumed.pfm") == read_file(d / "full.pfm"));
+  resume_run r = stop_and_resume(d, args, 16, d / "full.pfm");
+  INFO(r.resumed.output);
+  CHECK(r.stopped == 130);
+  REQUIRE(r.resumed.status == 0);
+  CHECK(r.same);
   auto said = run_bayeslight("render " + (d / "lamp.json") + " --sampler bayes --width 160 --height 120 --max-depth 3 " +
                              "--spp 40 -o " + (d / "s.pfm"));
   INFO(said.output);

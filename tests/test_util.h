@@ -145,6 +145,23 @@ inline run_result run_bayeslight(const std::string& args) {
   return r;
 }
 
+// A render (`args`: a render command without its output) stopped after `passes` passes with a checkpoint in `d`,
+// then resumed: the stopped run's status, the resumed run, and whether its image has the bytes of `full_path`.
+struct resume_run {
+  int stopped = -1;
+  run_result resumed;
+  bool same = false;
+};
+inline resume_run stop_and_resume(const temp_dir& d, const std::string& args, int passes, const std::string& full_path) {
+  resume_run r;
+  const std::string ck = d / "ck.bin";
+  r.stopped = run_bayeslight(args + " -o " + (d / "part.pfm") + " --checkpoint " + ck + " --stop-after-passes " +
+                             std::to_string(passes)).status;
+  r.resumed = run_bayeslight(args + " -o " + (d / "resumed.pfm") + " --resume " + ck);
+  r.same = r.resumed.status == 0 && read_text(d / "resumed.pfm") == read_text(full_path);
+  return r;
+}
+
 // Path of a file in the source tree.
 inline std::string source_path(const std::string& rel) { return std::string(BAYESLIGHT_SOURCE_DIR) + "/" + rel; }
 
