@@ -66,9 +66,10 @@ struct bayes_sampler {
   // written by the one task rendering its row (no races), and summed in pixel order.
   mutable std::vector<double> px_var, px_delta;  // (double: squares of radiance beyond float's range)
   mutable std::vector<double> px_delta_bvh;      // the same change under bvh sampling (empty: bvh is not checked)
-  // bvh's probability costs a descent of the tree per NEE event (130 ns a sample under 128 lights, 70 in the hall): it
-  // is checked in the first max_bvh_windows windows only, where a fallback gains most, and at every bvh_check_stride-th
-  // pixel only (a 320 x 240 window then holds 32768 samples' events).
+  // bvh's probability costs a descent of the tree per NEE event (checked at every pixel, the first 24 spp took 1.5x as
+  // long under 128 lights at 320 x 240, 1.17x in the hall): it is checked in the first max_bvh_windows windows only,
+  // where a fallback gains most, and at every bvh_check_stride-th pixel only (a 320 x 240 window then holds 32768
+  // samples' events; 1.0-1.07x and 1.04x).
   static constexpr int max_bvh_windows = 4;
   static constexpr int bvh_check_stride = 8;
   int bvh_windows = 0;  // windows that checked bvh so far

@@ -209,8 +209,7 @@ size_t sampler_memory_bytes(const light_sampler& s) {
            bytes_of(st.gtot) + bytes_of(st.gtot_cv) + bytes_of(st.unseen) + bytes_of(st.gunseen) + bytes_of(st.mw) +
            bytes_of(st.mw_cv) + bytes_of(b->child_link) +
            bytes_of(b->px_var) + bytes_of(b->px_delta) + bytes_of(b->px_delta_bvh) + bytes_of(b->px_first) +
-           bytes_of(b->px_prev) +
-           bytes_of(b->px_cur);
+           bytes_of(b->px_prev) + bytes_of(b->px_cur);
   }
   if (auto* d = std::get_if<donikian_sampler>(&s))
     return region_memory_bytes(d->deeper.regions) +

@@ -5,6 +5,7 @@
 
 #include <sys/resource.h>
 
+#include <cmath>
 #include <cstdio>
 
 namespace bl {
@@ -82,7 +83,7 @@ std::string render_summary(const render_result& r, const std::vector<std::string
     std::snprintf(buf, sizeof buf,
                   "; learning estimated to cut relMSE per sample %.3gx against power sampling", r.fallback_ratio);
     s += buf;
-    if (r.fallback_ratio_bvh > 0) {
+    if (r.fallback_ratio_bvh > 0 && std::isfinite(r.fallback_ratio_bvh)) {
       std::snprintf(buf, sizeof buf, " and %.3gx against bvh", r.fallback_ratio_bvh);
       s += buf;
     }
