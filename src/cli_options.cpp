@@ -71,10 +71,10 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "Adaptive samplers (bayes, donikian): a pass after n spp counts (n+1)/(n+1+S) per sample, so the first "
                 "passes, taken before much is learned, weigh less; in a direct render bayes's first 8 spp count "
                 "(n+1)/(n+1+4S), and where its check found learning to pay by then, its later passes (n+1)/(n+1+16S) "
-                "among themselves, their share of the image that of S; after bayes falls back to power sampling, the "
-                "later passes (one stratified set) weigh alike among themselves, their share of the image that of "
-                "(n+1)/(n+1+S); no weight or share depends on the samples it weighs, so the image stays unbiased "
-                "(default 4; 0: all samples alike)")
+                "among themselves, their share of the image that of S; after bayes falls back to power (or bvh) "
+                "sampling, the later passes (one stratified set) weigh alike among themselves, their share of the image "
+                "that of (n+1)/(n+1+S); no weight or share depends on the samples it weighs, so the image stays "
+                "unbiased (default 4; 0: all samples alike)")
       ->check(CLI::Range(0.0, 1e9))->check(finite_number);
   r->add_flag("--independent-samples", o.independent,
               "Independent random light choices, light points and BSDF directions at the first hit (default: "

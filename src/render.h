@@ -79,7 +79,7 @@ struct render_result {
   // bayes's staged pass weights (staged_pass_weight, direct renders): where its fallback check had found learning to
   // pay by the end of its first staged_spp spp, the film's sums of those passes (F_e) and their weight W_e, kept
   // apart; the later passes' share of the image is that of the plain schedule, late_ref_weight their weight under it
-  // (film_image). Likewise after bayes's fallback to power sampling (late_fallback): the passes before it kept apart,
+  // (film_image). Likewise after bayes's fallback (late_fallback): the passes before it kept apart,
   // the later ones weighing alike among themselves, with the share the plain schedule (their weights by their own
   // starts) gives them. Empty, 0 and false otherwise: the film alone is the image's sums.
   std::vector<double> early_film;
