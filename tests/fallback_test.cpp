@@ -438,12 +438,16 @@ TEST_CASE("bayes falls back to bvh where many lights are seen alike, determinist
   auto one = run_bayeslight(args + " --threads 1 -o " + (d / "one.pfm"));
   REQUIRE(one.status == 0);
   CHECK(read_file(d / "one.pfm") == read_file(d / "full.pfm"));
-  // Resumed after pass 16 (40 spp), past the fallback at the end of pass 15: the bvh passes' stratified set goes on.
-  resume_run r = stop_and_resume(d, args, 16, d / "full.pfm");
-  INFO(r.resumed.output);
-  CHECK(r.stopped == 130);
-  REQUIRE(r.resumed.status == 0);
-  CHECK(r.same);
+  // Resumed after pass 13 (22 spp: inside the second check window, its bvh sums saved) and after pass 16 (40 spp, past
+  // the fallback at the end of pass 15: the bvh passes' stratified set goes on).
+  for (int passes : {13, 16}) {
+    INFO("stopped after pass " << passes);
+    resume_run r = stop_and_resume(d, args, passes, d / "full.pfm");
+    INFO(r.resumed.output);
+    CHECK(r.stopped == 130);
+    REQUIRE(r.resumed.status == 0);
+    CHECK(r.same);
+  }
   auto said = run_bayeslight("render " + (d / "lamp.json") + " --sampler bayes --width 160 --height 120 --max-depth 3 " +
                              "--spp 40 -o " + (d / "s.pfm"));
   INFO(said.output);
