@@ -23,6 +23,20 @@
 
 namespace bl::test {
 
+// Built with a sanitizer (make test-sanitize, make test-tsan): a render costs tens to hundreds of times as much there,
+// so tests that render thousands of tiny images render fewer.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+inline constexpr bool sanitized_build = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+inline constexpr bool sanitized_build = true;
+#else
+inline constexpr bool sanitized_build = false;
+#endif
+#else
+inline constexpr bool sanitized_build = false;
+#endif
+
 // Regularised upper incomplete gamma Q(a, x) (series / continued fraction, double precision).
 inline double gamma_q(double a, double x) {
   if (x <= 0) return 1;
