@@ -435,14 +435,17 @@ void resume_render(const render_options& o, const render_params& params, const s
   }
   // An adaptive sampler's passes after a truncated one learn from other sample counts (and weigh theirs
   // otherwise) than one render's: still a correct image, but not the bytes the README promises at pass ends.
-  // Every pass of the saved render counts (a checkpoint of 10 spp reached through one of 9 is off schedule too).
+  // --light-points auto likewise: each pass draws its light points from a set of its own, with counts chosen from
+  // the passes before it, so the rest of a truncated pass is a pass of its own. Every pass of the saved render counts
+  // (a checkpoint of 10 spp reached through one of 9 is off schedule too).
   int off = 0;
   for (const pass_record& p : r.log)
     if (!ends_scheduled_pass(p.spp, int64_t(r.width) * r.height)) {
       off = p.spp;
       break;
     }
-  if (sampler_adapts(s) && off > 0 && (params.time_budget > 0 ? !budget_spent : params.spp > r.spp))
+  const bool adapts = sampler_adapts(s) || params.light_points == 0;
+  if (adapts && off > 0 && (params.time_budget > 0 ? !budget_spent : params.spp > r.spp))
     std::fprintf(stderr,
                  "%s: warning: its pass ending at %d spp did not end a scheduled pass (as 8 10 12 15 18 22 27 33 "
                  "... do; a --time render cuts its last pass to the time left): the continued image is correct, but not "

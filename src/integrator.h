@@ -63,6 +63,9 @@ struct render_inputs {
   int light_points = 1;
   const uint8_t* point_tiles = nullptr;
   int point_tile_cols = 0;
+  // With point_tiles and stratify: the pass's first sample and the key of its light-point sets, one per pixel
+  // (pass_point_uv; stratum_key_of of a seed of their own and point_base).
+  uint64_t point_base = 0, point_key = 0;
 };
 
 // What one sample reports beside its radiance (the choice of light points, light_points.h).
@@ -263,9 +266,10 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     // --light-points auto chooses a pixel's count from what earlier samples measured, its own among them; the
     // stratified light point of a sample depends on the set's earlier points, so a count chosen from their outcomes
     // would bias the estimate (as a model learned from them would: the light sets restart when a model changes). So
-    // under auto the points start from the sample's own unstratified numbers, and MIS weighs them as one point per
+    // under auto the points come from a set of the pass's own (pass_point_uv), whose counts were chosen before it
+    // began (unstratified samples: the sample's own numbers, as a lattice), and MIS weighs them as one point per
     // draw (both sides): given the light chosen, each count then has the same expectation, which no choice of count
-    // can tilt. The light choice, the BSDF direction and the camera jitter stay stratified.
+    // can tilt. The light choice, the BSDF direction and the camera jitter stay stratified as without auto.
     const int n_nee = in.nee_samples;
     const int points = depth == 1 ? points1 : 1;
     const bool chosen_points = depth == 1 && in.point_tiles != nullptr;
@@ -275,6 +279,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       vertex_randoms rk_own;
       const vertex_randoms* rk = &r;
       float point_u = fresh_u, point_v = fresh_v;
+      const bool pass_points = chosen_points && in.stratify;
+      const uint64_t point_draw = pass_points ? (sample - in.point_base) * uint64_t(n_nee) + uint64_t(k) : 0;
       if (n_nee > 1) {
         if (k > 0) {
           rk_own = draw_vertex(key, uint32_t(depth) | (uint32_t(k) << 20)), rk = &rk_own;
@@ -301,7 +307,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       for (int j = 0; j < points; j++) {
         t0 = tm.start();
         float u = chosen_points ? point_u : rk->u[dim_light_u], v = chosen_points ? point_v : rk->u[dim_light_v];
-        if (points > 1) light_point_uv(points, j, u, v);
+        if (pass_points) pass_point_uv(ps.point, point_draw, points, j, u, v);
+        else if (points > 1) light_point_uv(points, j, u, v);
         light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, u, v);
         vec3f fc = ls.pdf > 0 ? eval_bsdf_cos(bsdf, wo, ls.wi) : vec3f{0, 0, 0};
         tm.stop(prof_point, t0);
@@ -396,7 +403,7 @@ template <class Sampler, class Sink>
 vec3f trace_path(const render_inputs& in, const Sampler& sampler, int x, int y, uint64_t sample, path_stats& st,
                  Sink& sink, typename Sampler::context (&ctxs)[2], sample_info* info = nullptr) {
   no_timers tm;
-  pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * in.camera.width + x));
+  pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * in.camera.width + x), in.point_key);
   return trace_path_timed(in, sampler, x, y, ps, sample, st, sink, ctxs, tm, info);
 }
 

@@ -1,6 +1,8 @@
 // light_points: the lattice of a draw's points on its light, and the per-tile choice of their number.
 #include "light_points.h"
 
+#include "rng.h"
+
 #include <cmath>
 #include <numeric>
 
@@ -22,6 +24,12 @@ void light_point_uv(int points, int j, float& u, float& v) {
   const int g = lattice_generator(points);
   u = wrap01(u + float(j) / float(points));
   v = wrap01(v + float(int((int64_t(j) * g) % points)) / float(points));
+}
+
+void pass_point_uv(uint64_t hash, uint64_t draw, int points, int j, float& u, float& v) {
+  uint32_t a, b;
+  sobol_pair(uint32_t((draw + 1) * uint64_t(points) + uint64_t(j)), hash, a, b);
+  u = uint_to_unit(a), v = uint_to_unit(b);
 }
 
 tile_measure measure_tile(const double* s) {

@@ -35,6 +35,17 @@ constexpr double point_cost_per_vertex = 4;
 // lattice where K is a Fibonacci number), wrapped into [0, 1).
 void light_point_uv(int points, int j, float& u, float& v);
 
+// --light-points auto, stratified samples: point j of the K points of a pixel's draw number `draw` of a pass (the
+// pass's draws numbered from 0 in sample order, nee draws to a sample) is point (draw + 1) K + j of the pixel's
+// scrambled 2D Sobol' sequence of that pass (`hash`: its scramble; rng.h, sobol_pair). A draw's K points are then
+// consecutive points of one sequence: spread over the light (a block of 2^m from a multiple of 2^m is a net), and
+// apart from every other draw's points, while the pass's points of a light spread over it. The set is the pass's
+// alone, so the counts, chosen between passes from what earlier samples measured, cannot lean on where its points
+// fall. (The sequence starts one draw late: a draw and the next one, whose light choices take the two halves of
+// [0, 1) in the light set, would otherwise take the two halves of the light as well, a coupling that cost bayes 10 %
+// in the plant room, direct.)
+void pass_point_uv(uint64_t hash, uint64_t draw, int points, int j, float& u, float& v);
+
 // Per-tile statistics, point_stat_fields doubles per tile. Samples are weighted by g = 1 / (m^2 + 0.01), m the
 // pixel's luminance mean before the pass (relMSE's weight, SPEC.md §6), and counted only once the pixel has a mean.
 enum point_stat_field {

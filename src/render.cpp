@@ -27,6 +27,9 @@ namespace bl {
 
 namespace {
 
+// Mixed into the seed for the keys of --light-points auto's per-pass point sets (apart from the light sets' keys).
+constexpr uint64_t point_set_seed = 0x3c6ef372fe94f82bull;
+
 std::atomic<int> g_signal{0};
 std::atomic<int> g_signal_count{0};  // signals received (an output's wait ends on a new one)
 std::atomic<bool> g_first_pass{false};  // a render's first pass that a first signal lets finish is running
@@ -217,7 +220,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
               double* out = &pass_sum[3 * (size_t(y) * w + x)];
               // (Extended: the sums go on from the pass's earlier samples, added in the order one pass adds them.)
               double sum[3] = {extend ? out[0] : 0.0, extend ? out[1] : 0.0, extend ? out[2] : 0.0};
-              const pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * w + x));
+              const pixel_streams ps = pixel_streams_of(in.seed, in.stratum_key, uint64_t(y * w + x), in.point_key);
               if (!points) {
                 for (int s = s0; s < s1; s++) {
                   vec3f l = trace_path_timed(in, sampler, x, y, ps, uint64_t(s), st, sink, ctxs, tm);
@@ -435,6 +438,9 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     if (auto_points) {
       choose_tile_points(result.point_stats, done, pass, pin.nee_samples, tile_points);
       pin.point_tiles = tile_points.data();
+      // (The pass's light-point sets: integrator.h, pass_point_uv.)
+      pin.point_base = uint64_t(done);
+      pin.point_key = stratum_key_of(in.seed ^ point_set_seed, uint64_t(done));
       pin.point_tile_cols = tile_cols;
       gather.film_weight = result.film_weight;
       gather.mean_samples = done;

@@ -218,13 +218,15 @@ struct pixel_streams {
   // select, point: stratum_hashes_of the pass's light set (key stratum_key); bsdf: of the render's first set (key
   // stratum_key_of(seed, 0)), which the BSDF direction keeps for the whole render.
   stratum_hashes strata;
+  uint64_t point = 0;  // --light-points auto: the scramble of the pass's light-point set (key point_key)
 };
-inline pixel_streams pixel_streams_of(uint64_t seed, uint64_t stratum_key, uint64_t pixel) {
+inline pixel_streams pixel_streams_of(uint64_t seed, uint64_t stratum_key, uint64_t pixel, uint64_t point_key = 0) {
   pixel_streams ps;
   ps.key_base = pixel_key_base(seed, pixel);
   jitter_shift(seed, pixel, ps.shift_x, ps.shift_y);
   ps.strata = stratum_hashes_of(stratum_key, pixel);
   ps.strata.bsdf = stratum_hashes_of(stratum_key_of(seed, 0), pixel).bsdf;
+  if (point_key != 0) ps.point = stratum_hashes_of(point_key, pixel).point;
   return ps;
 }
 // The first vertex's stratified dimensions of sample `sample` of a render whose light set began at sample `base`

@@ -13,8 +13,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <fstream>
 #include <thread>
@@ -697,10 +699,19 @@ TEST_CASE("directions of any finite length point the same way", "[cli]") {
     REQUIRE(r.status == 0);
     return read_image(s.dir / (name + ".pfm")).pixels;
   };
+  // (Decimal 3e-26 is not 0.3 times 1e-25 in binary: the directions can differ in their last bit, and so the
+  // pixels by an ulp or so, as some did with these samples at 64 spp on 32 x 24. The same to 1e-6, where the other
+  // direction moves them by far more.)
+  auto largest_change = [](const std::vector<float>& a, const std::vector<float>& b) {
+    REQUIRE(a.size() == b.size());
+    double m = 0;
+    for (size_t i = 0; i < a.size(); i++) m = std::max(m, std::fabs(double(a[i]) - b[i]) / std::max(1.0, double(b[i])));
+    return m;
+  };
   std::vector<float> unit = render_with("unit", "[0.3, 1, 0.2]", "[0, 1, 0]");
-  CHECK(render_with("long", "[3e19, 1e20, 2e19]", "[0, 1e20, 0]") == unit);
-  CHECK(render_with("short", "[3e-26, 1e-25, 2e-26]", "[0, 1e-25, 0]") == unit);
-  CHECK(render_with("other", "[-0.3, 1, 0.2]", "[0, 1, 0]") != unit);  // the sun matters in this scene
+  CHECK(largest_change(render_with("long", "[3e19, 1e20, 2e19]", "[0, 1e20, 0]"), unit) < 1e-6);
+  CHECK(largest_change(render_with("short", "[3e-26, 1e-25, 2e-26]", "[0, 1e-25, 0]"), unit) < 1e-6);
+  CHECK(largest_change(render_with("other", "[-0.3, 1, 0.2]", "[0, 1, 0]"), unit) > 1e-2);  // the sun matters here
 }
 
 TEST_CASE("a scene's image size too large to render is no error once --width and --height replace it", "[cli]") {
@@ -1767,11 +1778,13 @@ TEST_CASE("a resumed log keeps errors only against the reference it is measured 
 
 TEST_CASE("resuming an adaptive render from a truncated pass warns that the bytes will differ", "[cli]") {
   // A checkpoint of --spp 9 (passes of 1 spp to 8, then 2 to 10: 9 ends no scheduled pass) continued to 12 spp is a
-  // correct image but not one render's bytes: the README says so, the command said nothing (a review).
+  // correct image but not one render's bytes: the README says so, the command said nothing (a review). The same for
+  // a fixed sampler under --light-points auto (the default), whose passes each draw their points from a set of their
+  // own (integrator.h); with a fixed count the fixed sampler's resumed image is the render's.
   tiny_scene d;
   std::string ck = d.dir / "ck.bin";
   const char* warning = "did not end a scheduled pass";
-  for (std::string sampler : {"bayes", "uniform"})
+  for (std::string sampler : {"bayes", "uniform", "uniform --light-points 2"})
     for (int first : {8, 9}) {
       std::string base = "render " + d.json + " --quiet --sampler " + sampler + " --threads 2";
       REQUIRE(run_bayeslight(base + " --spp " + std::to_string(first) + " --checkpoint " + ck + " -o " +
@@ -1782,7 +1795,7 @@ TEST_CASE("resuming an adaptive render from a truncated pass warns that the byte
       REQUIRE(run_bayeslight(base + " --spp 12 -o " + (d.dir / "w.pfm")).status == 0);
       bool same = read_text(d.dir / "r.pfm") == read_text(d.dir / "w.pfm");
       bool warned = r.output.find(warning) != std::string::npos;
-      CHECK(warned == (sampler == "bayes" && first == 9));
+      CHECK(warned == (sampler != "uniform --light-points 2" && first == 9));
       CHECK(same == !warned);  // (the warning is true: those bytes differ, the others do not)
     }
   // A chain: 9 spp, resumed to 10 (a scheduled end, but reached through 9), resumed to 12 (a review).

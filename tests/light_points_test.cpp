@@ -39,6 +39,52 @@ TEST_CASE("a draw's light points take one row and one column each of a K by K gr
   }
 }
 
+TEST_CASE("a pass's light points: each draw's spread over the light, none repeated, none coupled to the next draw's",
+          "[light_points]") {
+  // --light-points auto draws a pass's points from a set of its own (pass_point_uv). A lattice shifted by each
+  // draw's point of the stratified set (as fixed counts do) repeats, for every even K, the points of the draw paired
+  // with it in the set, whose point lies (1/2, 1/2) away; and consecutive points of the set taking the two halves of
+  // the light beside the two halves of the light choice cost bayes 10 % in the plant room (direct). Over many pixel
+  // scrambles: the K = 4 points of a draw take the four quadrants of the (u, v) square; 64 draws of 2 points give 128
+  // different points; and draws 2i and 2i + 1 of one point each are (1/2, 1/2) apart in only some pixels.
+  uint64_t state = 11;
+  int paired = 0, pairs = 0;
+  for (int trial = 0; trial < 200; trial++) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    const uint64_t hash = state ^ (state >> 29);
+    for (uint64_t draw = 0; draw < 16; draw++) {
+      std::set<int> quadrants;
+      for (int j = 0; j < 4; j++) {
+        float u, v;
+        pass_point_uv(hash, draw, 4, j, u, v);
+        REQUIRE(u >= 0);
+        REQUIRE(u < 1);
+        REQUIRE(v >= 0);
+        REQUIRE(v < 1);
+        quadrants.insert(int(u * 2) * 2 + int(v * 2));
+      }
+      CHECK(quadrants.size() == 4);
+    }
+    std::set<std::pair<float, float>> seen;
+    for (uint64_t draw = 0; draw < 64; draw++)
+      for (int j = 0; j < 2; j++) {
+        float u, v;
+        pass_point_uv(hash, draw, 2, j, u, v);
+        seen.insert({u, v});
+      }
+    CHECK(seen.size() == 128);
+    for (uint64_t draw = 0; draw < 64; draw += 2) {
+      float u0, v0, u1, v1;
+      pass_point_uv(hash, draw, 1, 0, u0, v0);
+      pass_point_uv(hash, draw + 1, 1, 0, u1, v1);
+      paired += std::fabs(std::fabs(u1 - u0) - 0.5f) < 1e-6f && std::fabs(std::fabs(v1 - v0) - 0.5f) < 1e-6f;
+      pairs++;
+    }
+  }
+  INFO(paired << " of " << pairs << " draw pairs (1/2, 1/2) apart");
+  CHECK(paired < pairs * 3 / 4);
+}
+
 namespace {
 // One tile's statistics for n samples of `points` points, each of weight g = 1, whose variance at one point is
 // rest + within, of `vertices` path vertices each.
