@@ -810,7 +810,9 @@ int run_cli(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return help_exit(app, e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);
+    // The parser's own messages (an unknown option, a value out of range) carry the prefix every other error has.
+    std::fprintf(stderr, "bayeslight: error: %s\nRun with --help for more information.\n", e.what());
     return exit_usage;
   }
   try {

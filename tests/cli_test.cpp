@@ -361,6 +361,8 @@ TEST_CASE("bad command lines exit 2 and name the problem", "[cli]") {
     INFO(c.args << "\n" << r.output);
     CHECK(r.status == 2);
     CHECK(r.output.find(c.expect) != std::string::npos);
+    // Every bad command line says so with the program's prefix, the parser's own messages too (--bogus).
+    CHECK(r.output.find("bayeslight: error: ") != std::string::npos);
   }
   CHECK(!exists(s.dir / "out.jpg"));
 }
