@@ -37,7 +37,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 25: ... with the share of the plain schedule (the passes before it kept apart)
 // 27: one cut shared by all regions with the sun alone; bayes with one light is power
 // 28: bayes's fallback check also weighs the bvh sampler, and can fall back to it
-constexpr uint32_t version = 29;  // 29: --light-points auto draws each pass's points from a set of its own
+// 29: --light-points auto draws each pass's points from a set of its own
+constexpr uint32_t version = 30;  // 30: --light-points auto's tile statistics hold blocks of samples (3 fields more)
 
 }  // namespace
 

@@ -39,12 +39,31 @@ tile_measure measure_tile(const double* s) {
   const double total = s[ps_sq_dev] / s[ps_mean_samples];
   m.cost = point_cost_per_vertex * s[ps_vertices] / s[ps_samples];
   m.samples = s[ps_mean_samples];
-  if (!(m.within >= 0) || !(m.cost > 0) || !std::isfinite(m.within + total + m.cost + s[ps_inv_points])) return m;
-  // What the rest of the sample adds (camera jitter, the light choice, the path past the first vertex): the samples'
-  // mix of point counts weighs the within part they had. Noise can take the difference below zero.
-  m.rest = std::max(0.0, total - m.within * s[ps_inv_points] / s[ps_mean_samples]);
+  if (!(m.within >= 0) || !(m.cost > 0) ||
+      !std::isfinite(m.within + total + m.cost + s[ps_inv_points] + s[ps_block_dev] + s[ps_block_ss]))
+    return m;
+  // What the pixel's mean keeps of a sample's variance: its samples are a stratified set (the light choice, the camera
+  // jitter), which removes much of (y - m)^2 from the mean. Over blocks of point_block consecutive samples from a
+  // multiple of point_block (each a block of the set), sum (y - m)^2 - sum (y - ybar)^2 = b (ybar - m)^2 estimates b
+  // Var(ybar) (plus b (m - mu)^2, the earlier mean's own error, small against it): the variance per sample of the
+  // blocks' means, whatever the samples' correlation. The Cornell box, direct, measured 0.0032 against (y - m)^2's
+  // 0.016 (HISTORY, stop 63). Without enough blocks (a tile of short passes), the sample's own variance.
+  const double kept = s[ps_blocks] >= point_min_blocks
+                          ? std::max(0.0, (s[ps_block_dev] - s[ps_block_ss]) / s[ps_blocks])
+                          : total;
+  // The rest (camera jitter, the light choice, the path past the first vertex): the samples' mix of point counts
+  // weighs the within part they had. Noise can take the difference below zero.
+  m.rest = std::max(0.0, kept - m.within * s[ps_inv_points] / s[ps_mean_samples]);
   m.ok = true;
   return m;
+}
+
+void add_point_block(double* s, const double* y, double m, double g) {
+  double mean = 0, dev = 0, ss = 0;
+  for (int i = 0; i < point_block; i++) mean += y[i];
+  mean /= point_block;
+  for (int i = 0; i < point_block; i++) dev += (y[i] - m) * (y[i] - m), ss += (y[i] - mean) * (y[i] - mean);
+  s[ps_block_dev] += g * dev, s[ps_block_ss] += g * ss, s[ps_blocks] += 1;
 }
 
 int best_points(double within, double rest, double lambda) {

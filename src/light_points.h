@@ -3,8 +3,8 @@
 // half hidden by leaves, the receiver's cosine across it) K times for the price of K - 1 more points; the choice of
 // light and the rest of the path are paid once. `auto` chooses K per tile of point_tile_size^2 pixels, between passes,
 // from what the tile's samples measured: the variance inside the lights (from the sample variance of each draw's
-// points), the sample's whole variance, and the sample's cost counted in path vertices (deterministic, so the choice
-// never depends on timing or threads).
+// points), what the pixel's mean keeps of a sample's variance (from blocks of its stratified samples), and the
+// sample's cost counted in path vertices (deterministic, so the choice never depends on timing or threads).
 // Invariants: each point is uniform over the light's (u, v) square (a lattice shifted by the draw's own point), so
 // a fixed K gives an unbiased estimate; under auto, whose counts depend on a pixel's own earlier samples, the points
 // start from the sample's unstratified numbers and MIS counts one point per draw (integrator.h), so that the choice
@@ -22,6 +22,10 @@ constexpr int point_tile_size = 8;     // pixels along a tile's side (--light-po
 constexpr int point_explore_spp = 8;   // auto: samples per pixel drawn with explore_points before choosing
 constexpr int point_explore_points = 2;
 constexpr int max_auto_points = 8;
+// auto: blocks of this many consecutive samples of a pass measure what a pixel's stratified mean keeps of a sample's
+// variance (measure_tile); a tile's measure takes them once it has point_min_blocks.
+constexpr int point_block = 8;
+constexpr double point_min_blocks = 16;
 constexpr size_t point_reexplore_passes = 8;  // auto: a tile at one point takes two on one pass in this many
 // The tiles' statistics are scaled by this at every pass's end before its own are added: the choice follows what the
 // latest passes measured (an adaptive sampler's variance falls as it learns).
@@ -56,17 +60,25 @@ enum point_stat_field {
   ps_inv_points,      // sum of 1 / K over those
   ps_within,          // sum of g * sample_info::within over those of K >= 2
   ps_within_samples,  // how many those are
+  ps_block_dev,       // blocks of point_block consecutive samples of a pass (from a multiple of point_block): the sum
+                      // of g (y - m)^2 over their samples
+  ps_block_ss,        // the sum of g times each block's squared deviations from its own mean
+  ps_blocks,          // how many blocks
   point_stat_fields
 };
 
 // What a tile measured, per sample (relMSE-weighted variances): the variance inside the chosen lights at one point,
-// the rest, and the cost in extra points (path vertices times point_cost_per_vertex). ok = false without data (or
-// with non-finite sums): such a tile keeps one point.
+// the rest that the pixel's mean keeps (its stratified set's blocks, measure_tile), and the cost in extra points
+// (path vertices times point_cost_per_vertex). ok = false without data (or with non-finite sums): such a tile keeps
+// one point.
 struct tile_measure {
   double within = 0, rest = 0, cost = 0, samples = 0;
   bool ok = false;
 };
 tile_measure measure_tile(const double* s);
+// Adds to a tile's statistics `s` a block of one pixel's samples (their luminances y[0..point_block), samples
+// k point_block to (k + 1) point_block - 1 of a pass), m the pixel's mean before the pass and g its weight.
+void add_point_block(double* s, const double* y, double m, double g);
 
 // The count (1, 2, 3, 5 or 8) that minimises rest + within / K + lambda (K - 1): a tile's share of the image's error
 // plus lambda times its share of the render's time. lambda is the image's error per unit of time, so the choice

@@ -239,6 +239,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                   g = 1.0 / (m * m + 0.01);
                   mean_noise = points->mean_samples / (points->mean_samples + 1);
                 }
+                double block[point_block] = {};
                 for (int s = s0; s < s1; s++) {
                   const uint64_t vertices = st.camera_rays + st.bounce_rays;
                   sample_info info;
@@ -253,6 +254,9 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                     slot[ps_sq_dev] += g * mean_noise * d * d;
                     slot[ps_inv_points] += 1.0 / info.points;
                     if (info.points > 1) slot[ps_within] += g * info.within, slot[ps_within_samples] += 1;
+                    block[s % point_block] = luminance(l.x, l.y, l.z);
+                    if (s % point_block == point_block - 1 && s - (point_block - 1) >= s0)
+                      add_point_block(slot, block, m, g);
                   }
                 }
               }

@@ -1,5 +1,6 @@
 // Tests of light_points: the lattice of a draw's points on its light, and the choice of their number per tile.
 #include "light_points.h"
+#include "rng.h"
 #include "test_util.h"
 
 #include <catch2/catch.hpp>
@@ -115,6 +116,50 @@ TEST_CASE("a tile's measures come back from its sums, whatever mix of point coun
   CHECK(m.rest == Approx(0.15));
   CHECK(m.cost == Approx(3 * point_cost_per_vertex));
   CHECK(m.samples == 4500);
+}
+
+TEST_CASE("blocks of a pixel's samples measure what its stratified mean keeps of their variance", "[light_points]") {
+  // y = u on [0, 1) (mean 1/2, variance 1/12): blocks of point_block samples, one in each of point_block equal strata
+  // (what a block of a pixel's stratified set does to a smooth integrand), keep point_block Var(ybar) = 1 /
+  // (12 point_block^2) per sample; independent ones keep all of 1/12. 20000 blocks of each, seeded: the estimate's
+  // relative standard error is under 2 % in both cases, the bounds 4 %.
+  pcg32 rng(12345u, 7u);
+  auto unit = [&] { return double(rng() >> 8) * 0x1p-24; };
+  const int blocks = 20000;
+  const double b = point_block;
+  for (bool strata : {true, false}) {
+    std::vector<double> s(point_stat_fields, 0.0);
+    double y[point_block];
+    for (int k = 0; k < blocks; k++) {
+      for (int i = 0; i < point_block; i++) y[i] = strata ? (i + unit()) / b : unit();
+      add_point_block(s.data(), y, 0.5, 2.0);  // (weight 2: the sums carry it, the estimate divides it out below)
+    }
+    CHECK(s[ps_blocks] == blocks);
+    const double kept = (s[ps_block_dev] - s[ps_block_ss]) / s[ps_blocks] / 2.0;
+    const double expect = strata ? 1 / (12 * b * b) : 1.0 / 12;
+    INFO((strata ? "stratified" : "independent") << ": kept " << kept << ", expected " << expect);
+    CHECK(kept == Approx(expect).epsilon(0.04));
+  }
+}
+
+TEST_CASE("a tile's rest is what its blocks keep, once it has enough of them", "[light_points]") {
+  // A whole variance of 1 per sample (rest 0.15 + within 0.85 at one point), of which the blocks say the mean keeps
+  // 0.5: with two points the within part is 0.425, so the rest is 0.075.
+  std::vector<double> s = tile_stats(0.15, 0.85, 3, 2);
+  s[ps_block_dev] = point_min_blocks * 8.0, s[ps_block_ss] = point_min_blocks * 7.5, s[ps_blocks] = point_min_blocks;
+  tile_measure m = measure_tile(s.data());
+  REQUIRE(m.ok);
+  CHECK(m.within == Approx(0.85));
+  CHECK(m.rest == Approx(0.5 - 0.85 / 2));
+  // Fewer blocks: the sample's own variance, as before.
+  s[ps_blocks] = point_min_blocks - 1;
+  CHECK(measure_tile(s.data()).rest == Approx(0.15));
+  // Blocks that keep less than the within part (noise): no rest.
+  s[ps_blocks] = point_min_blocks, s[ps_block_ss] = point_min_blocks * 7.9;
+  CHECK(measure_tile(s.data()).rest == 0);
+  // Non-finite block sums: no measure.
+  s[ps_block_dev] = INFINITY;
+  CHECK(!measure_tile(s.data()).ok);
 }
 
 TEST_CASE("a tile without data or with non-finite sums keeps one point", "[light_points]") {
