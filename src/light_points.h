@@ -7,8 +7,9 @@
 // sample's cost counted in path vertices (deterministic, so the choice never depends on timing or threads).
 // Invariants: each point is uniform over the light's (u, v) square (a lattice shifted by the draw's own point), so
 // a fixed K gives an unbiased estimate; under auto, whose counts depend on a pixel's own earlier samples, the points
-// start from the sample's unstratified numbers and MIS counts one point per draw (integrator.h), so that the choice
-// of count cannot tilt the estimate either; the statistics are summed in pixel order within a row and in row order
+// come from a set of the pass's own, whose counts were chosen before it began (pass_point_uv; unstratified samples:
+// the sample's own numbers), and MIS counts one point per draw (integrator.h), so that the choice of count cannot
+// tilt the estimate either; the statistics are summed in pixel order within a row and in row order
 // within a tile, and are only read between passes.
 #pragma once
 
