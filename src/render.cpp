@@ -249,12 +249,12 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                   slot[ps_samples] += 1;
                   slot[ps_vertices] += double(st.camera_rays + st.bounce_rays - vertices);
                   if (has_mean) {
-                    const double d = luminance(l.x, l.y, l.z) - m;
+                    const double y_lum = luminance(l.x, l.y, l.z), d = y_lum - m;
                     slot[ps_mean_samples] += 1;
                     slot[ps_sq_dev] += g * mean_noise * d * d;
                     slot[ps_inv_points] += 1.0 / info.points;
                     if (info.points > 1) slot[ps_within] += g * info.within, slot[ps_within_samples] += 1;
-                    block[s % point_block] = luminance(l.x, l.y, l.z);
+                    block[s % point_block] = y_lum;
                     if (s % point_block == point_block - 1 && s - (point_block - 1) >= s0)
                       add_point_block(slot, block, m, g);
                   }
