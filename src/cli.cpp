@@ -7,6 +7,7 @@
 #include "cli_options.h"
 #include "cli_validators.h"
 #include "compare.h"
+#include "error_image.h"
 #include "errors.h"
 #include "file_io.h"
 #include "image_io.h"
@@ -653,20 +654,57 @@ int run_render(const render_options& o) {
 }
 
 int run_diff(const diff_options& o) {
+  if (!o.error_map.empty() && image_format_of(o.error_map) == image_format::unknown)
+    throw usage_error("--error-map " + o.error_map + ": unknown image format (expected .exr, .pfm or .png)");
   image_data a = read_image(o.a), b = read_image(o.b);
   if (a.width != b.width || a.height != b.height)
     throw input_error(o.b, "size " + std::to_string(b.width) + "x" + std::to_string(b.height) + " differs from " +
                                o.a + " (" + std::to_string(a.width) + "x" + std::to_string(a.height) + ")");
   // Bit-equal pixel data are identical whatever they hold (SPEC 4), NaN and infinities included: no error.
-  if (bit_identical(a, b)) {
+  const bool identical = bit_identical(a, b);
+  error_metrics e;
+  if (!identical) {
+    // Otherwise a non-finite pixel has no error: say where it is rather than print nan (exit 3, like a reference's).
+    require_finite(a, o.a, "image");
+    require_finite(b, o.b, "image");
+    e = compute_error(a, b);
+  }
+  error_spread spread;
+  // (An identical pair's map is all zero, NaN pixels included.)
+  if (o.worst > 0 || !o.error_map.empty()) spread = identical ? error_spread{} : spread_of_error(a, b, size_t(o.worst));
+  if (identical && !o.error_map.empty()) spread.term.assign(size_t(b.width) * size_t(b.height), 0.0);
+  if (!o.error_map.empty()) {
+    // .png: compare's false-colour image (error_image.h); .exr/.pfm: each pixel's relMSE term in its three channels.
+    if (image_format_of(o.error_map) == image_format::png) {
+      write_error_image(o.error_map, a, b, error_image_params{});
+    } else {
+      image_data map;
+      map.width = b.width, map.height = b.height;
+      map.pixels.resize(spread.term.size() * 3);
+      for (size_t i = 0; i < spread.term.size(); i++)
+        map.pixels[3 * i] = map.pixels[3 * i + 1] = map.pixels[3 * i + 2] = float(spread.term[i]);
+      write_image(o.error_map, map);
+    }
+  }
+  if (identical) {
     std::printf("relmse=0 mse=0 maxabs=0\nidentical\n");
     return exit_ok;
   }
-  // Otherwise a non-finite pixel has no error: say where it is rather than print nan (exit 3, like a reference's).
-  require_finite(a, o.a, "image");
-  require_finite(b, o.b, "image");
-  error_metrics e = compute_error(a, b);
   std::printf("relmse=%.9g mse=%.9g maxabs=%.9g\n", e.relmse, e.mse, e.maxabs);
+  if (o.worst > 0) {
+    std::printf("worst pixels:");
+    for (int k = 0; k < 3; k++)
+      std::printf("%s %g%% (%zu) %s%.1f%%%s", k > 0 ? "," : "", 100 * error_tail_fractions[k], spread.tail_pixels[k],
+                  k == 0 ? "hold " : "", 100 * spread.tail_share[k], k == 0 ? " of the relmse" : "");
+    std::printf("\n");
+    const double total = e.relmse * double(spread.term.size());
+    for (size_t i : spread.worst) {
+      const float *x = &a.pixels[3 * i], *r = &b.pixels[3 * i];
+      std::printf("pixel %zu %zu: %.2f%% of the relmse; value %.6g %.6g %.6g, reference %.6g %.6g %.6g\n",
+                  i % size_t(b.width), i / size_t(b.width), total > 0 ? 100 * spread.term[i] / total : 0.0, x[0], x[1],
+                  x[2], r[0], r[1], r[2]);
+    }
+  }
   return exit_ok;
 }
 
@@ -777,6 +815,16 @@ int run_cli(int argc, char** argv) {
   CLI::App* diff = app.add_subcommand("diff", "Compare two images: relmse, mse, maxabs; 'identical' if bit-equal");
   diff->add_option("A", dopt.a, "Image (.exr/.pfm)")->required()->type_name("FILE");
   diff->add_option("B", dopt.b, "Image (.exr/.pfm), the reference")->required()->type_name("FILE");
+  diff->add_option("--worst", dopt.worst,
+                   "Also print the share of the relmse the worst 0.1 %, 1 % and 5 % of the pixels hold, and the N worst "
+                   "pixels (x y from the top left, their share, both values): fireflies or noise spread over the image")
+      ->check(CLI::Range(0, 1000000))
+      ->type_name("N");
+  diff->add_option("--error-map", dopt.error_map,
+                   "Write where the error lies to FILE: .exr/.pfm each pixel's relmse term (the mean of its channels' "
+                   "(a - b)^2 / (b^2 + 0.01); the image's mean is the relmse) in all three channels; .png compare's "
+                   "false-colour relative error |a - b| / (|b| + 0.1) (viridis, log scale from 1e-3 to 1)")
+      ->type_name("FILE");
   std::string first = argc >= 2 ? argv[1] : "";
   if (argc == 2 && (first == "--version" || first == "-V")) {
     print_version();

@@ -5,6 +5,7 @@
 
 #include "errors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -35,6 +36,44 @@ error_metrics compute_error(const image_data& x, const image_data& ref, const st
 }
 
 error_metrics compute_error(const image_data& x, const image_data& ref) { return compute_error(x, ref, "reference"); }
+
+error_spread spread_of_error(const image_data& x, const image_data& ref, size_t count) {
+  if (x.width != ref.width || x.height != ref.height || x.pixels.size() != ref.pixels.size())
+    compute_error(x, ref);  // (throws the size mismatch's error)
+  error_spread s;
+  const size_t n = ref.pixels.size() / 3;
+  s.term.resize(n);
+  double total = 0;
+  for (size_t i = 0; i < n; i++) {
+    double t = 0;
+    for (size_t c = 0; c < 3; c++) {
+      const double r = ref.pixels[3 * i + c], d = double(x.pixels[3 * i + c]) - r;
+      t += d * d / (r * r + 0.01);
+    }
+    s.term[i] = t / 3;
+    total += s.term[i];
+  }
+  if (n == 0) return s;
+  // Worst first, ties by index (a total order: the same list on every machine).
+  auto worse = [&](size_t a, size_t b) { return s.term[a] > s.term[b] || (s.term[a] == s.term[b] && a < b); };
+  size_t widest = 0;
+  for (int k = 0; k < 3; k++) {
+    s.tail_pixels[k] = std::max<size_t>(1, size_t(std::floor(error_tail_fractions[k] * double(n))));
+    widest = std::max(widest, s.tail_pixels[k]);
+  }
+  const size_t ranked = std::min(n, std::max(widest, count));
+  std::vector<size_t> order(n);
+  for (size_t i = 0; i < n; i++) order[i] = i;
+  std::partial_sort(order.begin(), order.begin() + ptrdiff_t(ranked), order.end(), worse);
+  double run = 0;
+  for (size_t k = 0, next = 0; k < 3; k++) {
+    for (; next < s.tail_pixels[k]; next++) run += s.term[order[next]];
+    s.tail_share[k] = total > 0 ? run / total : 0.0;
+  }
+  order.resize(std::min(count, n));
+  s.worst = std::move(order);
+  return s;
+}
 
 bool bit_identical(const image_data& a, const image_data& b) {
   if (a.width != b.width || a.height != b.height || a.pixels.size() != b.pixels.size()) return false;

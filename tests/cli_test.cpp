@@ -1,7 +1,9 @@
 // Tests of the command line as users drive it: exit statuses (SPEC.md section 4), messages that name the
 // problem (file and line), no output file left behind by a failure, the diff command, and the per-pass log.
 #include "checkpoint.h"
+#include "error_image.h"
 #include "image_io.h"
+#include "metrics.h"
 #include "render.h"
 #include "scene_desc.h"
 #include "test_util.h"
@@ -240,6 +242,62 @@ TEST_CASE("the log carries error against a reference and diff reports it", "[cli
   CHECK(std::stod(relmse_log) == Approx(std::stod(relmse_diff)).epsilon(1e-6));
   auto same = run_bayeslight("diff " + (s.dir / "x.exr") + " " + (s.dir / "x.exr"));
   CHECK(same.output.find("identical") != std::string::npos);
+}
+
+TEST_CASE("diff --worst and --error-map show where the error lies", "[cli]") {
+  // A 20 x 10 pair: pixel (13, 4) errs by 1 in red, pixel (2, 7) by 0.1 in all channels, every other by 0.01 in green.
+  tiny_scene s;
+  image_data ref, img;
+  ref.width = img.width = 20, ref.height = img.height = 10;
+  ref.pixels.assign(600, 0.5f);
+  img.pixels = ref.pixels;
+  for (size_t i = 0; i < 200; i++) img.pixels[3 * i + 1] += 0.01f;
+  img.pixels[3 * (4 * 20 + 13)] += 1.0f;
+  for (int c = 0; c < 3; c++) img.pixels[3 * (7 * 20 + 2) + c] += 0.1f;
+  write_image(s.dir / "a.pfm", img);
+  write_image(s.dir / "b.pfm", ref);
+  const std::string pair = (s.dir / "a.pfm") + " " + (s.dir / "b.pfm");
+  auto d = run_bayeslight("diff " + pair + " --worst 2 --error-map " + (s.dir / "map.pfm"));
+  INFO(d.output);
+  REQUIRE(d.status == 0);
+  const error_spread spread = spread_of_error(img, ref, 2);
+  // The metrics' line first, unchanged; then the shares (of 200 pixels the worst 0.1 % is one: at least one each).
+  CHECK(d.output.rfind("relmse=", 0) == 0);
+  char share[64];
+  std::snprintf(share, sizeof share, "0.1%% (1) hold %.1f%% of the relmse", 100 * spread.tail_share[0]);
+  CHECK(d.output.find(share) != std::string::npos);
+  CHECK(d.output.find(", 1% (2) ") != std::string::npos);
+  CHECK(d.output.find(", 5% (10) ") != std::string::npos);
+  const size_t first = d.output.find("pixel 13 4: "), second = d.output.find("pixel 2 7: ");
+  CHECK(first != std::string::npos);
+  CHECK(second > first);
+  CHECK(second != std::string::npos);
+  CHECK(d.output.find("reference 0.5 0.5 0.5") != std::string::npos);
+  // The map holds each pixel's term in all three channels; its mean is the relmse.
+  const image_data map = read_image(s.dir / "map.pfm");
+  REQUIRE(map.pixels.size() == 600);
+  double sum = 0;
+  for (size_t i = 0; i < 200; i++) {
+    CHECK(map.pixels[3 * i] == float(spread.term[i]));
+    CHECK(map.pixels[3 * i + 2] == map.pixels[3 * i]);
+    sum += map.pixels[3 * i];
+  }
+  CHECK(sum / 200 == Approx(compute_error(img, ref).relmse).epsilon(1e-6));
+  // .png: compare's false-colour image of the pair.
+  REQUIRE(run_bayeslight("diff " + pair + " --error-map " + (s.dir / "map.png")).status == 0);
+  CHECK(read_text(s.dir / "map.png") == encode_error_png(img, ref, error_image_params{}));
+  // Identical images: the map is all zero and nothing else is printed.
+  auto same = run_bayeslight("diff " + (s.dir / "b.pfm") + " " + (s.dir / "b.pfm") + " --worst 3 --error-map " +
+                             (s.dir / "zero.pfm"));
+  CHECK(same.output == "relmse=0 mse=0 maxabs=0\nidentical\n");
+  const image_data zero = read_image(s.dir / "zero.pfm");
+  CHECK(zero.pixels == std::vector<float>(600, 0.0f));
+  // A map of no known format is a bad command line (exit 2), and nothing is written.
+  auto bad = run_bayeslight("diff " + pair + " --error-map " + (s.dir / "map.txt"));
+  CHECK(bad.status == 2);
+  CHECK(bad.output.find("bayeslight: error: --error-map") != std::string::npos);
+  CHECK(!std::filesystem::exists(s.dir / "map.txt"));
+  CHECK(run_bayeslight("diff " + pair + " --worst -1").status == 2);
 }
 
 TEST_CASE("a render with a reference and no log reports the error of its image", "[cli]") {
