@@ -670,9 +670,10 @@ int run_diff(const diff_options& o) {
     e = compute_error(a, b);
   }
   error_spread spread;
-  // (An identical pair's map is all zero, NaN pixels included.)
-  if (o.worst > 0 || !o.error_map.empty()) spread = identical ? error_spread{} : spread_of_error(a, b, size_t(o.worst));
-  if (identical && !o.error_map.empty()) spread.term.assign(size_t(b.width) * size_t(b.height), 0.0);
+  if (o.worst > 0 || !o.error_map.empty()) {
+    if (identical) spread.term.assign(size_t(b.width) * size_t(b.height), 0.0);  // (no error, NaN pixels included)
+    else spread = spread_of_error(a, b, size_t(o.worst));
+  }
   if (!o.error_map.empty()) {
     // .png: compare's false-colour image (error_image.h); .exr/.pfm: each pixel's relMSE term in its three channels.
     if (image_format_of(o.error_map) == image_format::png) {

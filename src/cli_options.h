@@ -60,7 +60,7 @@ struct render_options {
 struct diff_options {
   std::string a, b;
   int worst = 0;          // --worst: the shares of the worst pixels and the N worst, after the metrics (0: off)
-  std::string error_map;  // --error-map: each pixel's relMSE term (.exr/.pfm), or a heat map of it (.png)
+  std::string error_map;  // --error-map: each pixel's relMSE term (.exr/.pfm), or compare's false-colour image (.png)
 };
 
 // Options of `compare` (render.sampler, render.outputs and render.log are unused).
