@@ -11,13 +11,21 @@
 
 namespace bl {
 
+namespace {
+// One channel's term of the relMSE: (x - r)^2 / (r^2 + 0.01), in double.
+double relative_sq_error(double x, double r) {
+  const double d = x - r;
+  return d * d / (r * r + 0.01);
+}
+}  // namespace
+
 error_metrics compute_error(const float* x, const float* ref, size_t n) {
   error_metrics m;
   if (n == 0) return m;
   double sum_rel = 0, sum_sq = 0, maxabs = 0;
   for (size_t i = 0; i < n; ++i) {
     const double r = ref[i], d = double(x[i]) - r, d2 = d * d;
-    sum_rel += d2 / (r * r + 0.01);
+    sum_rel += relative_sq_error(x[i], r);
     sum_sq += d2;
     const double ad = std::fabs(d);
     if (ad > maxabs || std::isnan(ad)) maxabs = ad;  // once NaN, stays NaN (NaN compares false)
@@ -46,10 +54,7 @@ error_spread spread_of_error(const image_data& x, const image_data& ref, size_t 
   double total = 0;
   for (size_t i = 0; i < n; i++) {
     double t = 0;
-    for (size_t c = 0; c < 3; c++) {
-      const double r = ref.pixels[3 * i + c], d = double(x.pixels[3 * i + c]) - r;
-      t += d * d / (r * r + 0.01);
-    }
+    for (size_t c = 0; c < 3; c++) t += relative_sq_error(x.pixels[3 * i + c], ref.pixels[3 * i + c]);
     s.term[i] = t / 3;
     total += s.term[i];
   }
