@@ -38,7 +38,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 27: one cut shared by all regions with the sun alone; bayes with one light is power
 // 28: bayes's fallback check also weighs the bvh sampler, and can fall back to it
 // 29: --light-points auto draws each pass's points from a set of its own
-constexpr uint32_t version = 30;  // 30: --light-points auto's tile statistics hold blocks of samples (3 fields more)
+// 30: --light-points auto's tile statistics hold blocks of samples (3 fields more)
+constexpr uint32_t version = 31;  // 31: --light-points auto draws each light's points from a set of its own
 
 }  // namespace
 

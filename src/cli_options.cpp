@@ -79,7 +79,8 @@ void add_render_options(CLI::App* r, render_options& o) {
   r->add_flag("--independent-samples", o.independent,
               "Independent random light choices, light points and BSDF directions at the first hit (default: "
               "stratified over each pixel's samples; the light choice and point of the adaptive samplers over the "
-              "samples since their model last changed, the points of --light-points auto over each pass's)");
+              "samples since their model last changed, the points of --light-points auto over each light's draws in a "
+              "pass)");
   // Regions, cuts and the ablation switches of the adaptive samplers.
   const char* grp = region_group;
   r->add_option("--grid", o.regions.grid,

@@ -76,6 +76,9 @@ struct sample_info {
   // point.
   double within = 0;
   int points = 1;  // light points per draw at the first vertex
+  // Input: the pixel's draws per light so far in this run of the pass (light_pass_point_uv); null: the pass's
+  // shared point set for every draw.
+  light_draw_counts* counts = nullptr;
 };
 
 // Counters of one worker's share of a pass (summed in a fixed order afterwards).
@@ -199,7 +202,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
   float prev_bsdf_pdf = 0;
   float prev_nee_points = 1;       // ... whose NEE drew this many light points (draws times points per draw)
   const int points1 = in.point_tiles ? int(in.point_tiles[point_tile_of(x, y, in.point_tile_cols)]) : in.light_points;
-  if (info) *info = sample_info{0, points1};
+  if (info) info->within = 0, info->points = points1;
   int from_tri = invalid_id;       // a continuation ray: the triangle it leaves, and its normal (org is its point)
   vec3f from_ng;
   for (int depth = 1;; depth++) {
@@ -266,10 +269,12 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     // --light-points auto chooses a pixel's count from what earlier samples measured, its own among them; the
     // stratified light point of a sample depends on the set's earlier points, so a count chosen from their outcomes
     // would bias the estimate (as a model learned from them would: the light sets restart when a model changes). So
-    // under auto the points come from a set of the pass's own (pass_point_uv), whose counts were chosen before it
-    // began (unstratified samples: the sample's own numbers, as a lattice), and MIS weighs them as one point per
-    // draw (both sides): given the light chosen, each count then has the same expectation, which no choice of count
-    // can tilt. The light choice, the BSDF direction and the camera jitter stay stratified as without auto.
+    // under auto the points come from sets of the pass's own, one per light a pixel's draws chose (light_pass_point_uv;
+    // past light_draw_counts::max_lights lights in a pixel's pass, one shared by the rest: pass_point_uv), whose
+    // counts were chosen before it began (unstratified samples: the sample's own numbers, as a lattice), and MIS
+    // weighs them as one point per draw (both sides): given the light chosen, each count then has the same
+    // expectation, which no choice of count can tilt. The light choice, the BSDF direction and the camera jitter stay
+    // stratified as without auto.
     const int n_nee = in.nee_samples;
     const int points = depth == 1 ? points1 : 1;
     const bool chosen_points = depth == 1 && in.point_tiles != nullptr;
@@ -300,6 +305,10 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       if constexpr (has_control_variates<Sampler>::value) cv_light = sampler.cv_covers(ctx, choice.cluster);
       st.nee_samples++;
       if (depth == 1) st.first_draws++, st.first_points += uint64_t(points);
+      // (Under auto, stratified: the points of this light's own set, light_pass_points; -1: the pass's shared set.)
+      const int64_t light_draw =
+          pass_points && info && info->counts ? info->counts->next(choice.light) : -1;
+      const uint64_t light_hash = light_draw >= 0 ? light_points_hash(ps.point, *info->counts, choice.light) : 0;
       float value = 0, added = 0, added_total = 0;
       vec3f unweighted_sum = {0, 0, 0}, add_sum = {0, 0, 0};
       bool seen = false;  // a point was visible
@@ -307,7 +316,8 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       for (int j = 0; j < points; j++) {
         t0 = tm.start();
         float u = chosen_points ? point_u : rk->u[dim_light_u], v = chosen_points ? point_v : rk->u[dim_light_v];
-        if (pass_points) pass_point_uv(ps.point, point_draw, points, j, u, v);
+        if (light_draw >= 0) light_pass_point_uv(light_hash, uint32_t(light_draw), points, j, u, v);
+        else if (pass_points) pass_point_uv(ps.point, point_draw, points, j, u, v);
         else if (points > 1) light_point_uv(points, j, u, v);
         light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, u, v);
         vec3f fc = ls.pdf > 0 ? eval_bsdf_cos(bsdf, wo, ls.wi) : vec3f{0, 0, 0};

@@ -3,6 +3,7 @@
 
 #include "rng.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -30,6 +31,35 @@ void pass_point_uv(uint64_t hash, uint64_t draw, int points, int j, float& u, fl
   uint32_t a, b;
   sobol_pair(uint32_t((draw + 1) * uint64_t(points) + uint64_t(j)), hash, a, b);
   u = uint_to_unit(a), v = uint_to_unit(b);
+}
+
+void light_pass_point_uv(uint64_t hash, uint32_t count, int points, int j, float& u, float& v) {
+  uint32_t a, b;
+  sobol_pair(count * uint32_t(points) + uint32_t(j), hash, a, b);
+  u = uint_to_unit(a), v = uint_to_unit(b);
+}
+
+uint64_t light_points_hash(uint64_t pass_hash, const light_draw_counts& c, int light) {
+  return mix64(pass_hash ^ c.salt ^ (uint64_t(uint32_t(light)) * 0xd6e8feb86659fd93ull));
+}
+
+light_draw_counts::light_draw_counts() { std::fill(light_, light_ + slots, -1); }
+
+void light_draw_counts::reset(uint64_t run_start) {
+  for (int i = 0; i < used_; i++) light_[used_at_[i]] = -1;
+  used_ = 0;
+  salt = mix64(run_start ^ 0xa54ff53a5f1d36f1ull);
+}
+
+int64_t light_draw_counts::next(int light) {
+  uint32_t i = (uint32_t(light) * 0x9e3779b1u) >> 24;  // (slots = 2^8)
+  for (;; i = (i + 1) & (slots - 1)) {
+    if (light_[i] == light) return int64_t(count_[i]++);
+    if (light_[i] < 0) break;
+  }
+  if (used_ == max_lights) return -1;
+  light_[i] = light, count_[i] = 1, used_at_[used_++] = uint16_t(i);
+  return 0;
 }
 
 tile_measure measure_tile(const double* s) {

@@ -7,8 +7,9 @@
 // sample's cost counted in path vertices (deterministic, so the choice never depends on timing or threads).
 // Invariants: each point is uniform over the light's (u, v) square (a lattice shifted by the draw's own point), so
 // a fixed K gives an unbiased estimate; under auto, whose counts depend on a pixel's own earlier samples, the points
-// come from a set of the pass's own, whose counts were chosen before it began (pass_point_uv; unstratified samples:
-// the sample's own numbers), and MIS counts one point per draw (integrator.h), so that the choice of count cannot
+// come from sets of the pass's own, one per light a pixel's draws chose, whose counts were chosen before it began
+// (light_pass_point_uv; unstratified samples: the sample's own numbers), and MIS counts one point per draw
+// (integrator.h), so that the choice of count cannot
 // tilt the estimate either; the statistics are summed in pixel order within a row and in row order
 // within a tile, and are only read between passes.
 #pragma once
@@ -50,6 +51,35 @@ void light_point_uv(int points, int j, float& u, float& v);
 // [0, 1) in the light set, would otherwise take the two halves of the light as well, a coupling that cost bayes 10 %
 // in the plant room, direct.)
 void pass_point_uv(uint64_t hash, uint64_t draw, int points, int j, float& u, float& v);
+
+// --light-points auto, stratified samples: each light's own point set in a pixel's run of a pass. A draw that
+// chose light L takes, for its K points, points cK .. cK + K - 1 of a scrambled 2D Sobol' sequence of L's own
+// (`hash`: light_points_hash, from the pixel's pass set, L and the run's first sample), c the draws of L before it in
+// the run: the points that fall on one light are a stratified set of their own, however the light choices
+// interleave. Each point stays uniform over the light whatever the earlier choices were (its sequence's scramble is
+// independent of them), so the estimate stays unbiased.
+void light_pass_point_uv(uint64_t hash, uint32_t count, int points, int j, float& u, float& v);
+
+// The draws of each light so far in one pixel's run of a pass (light_pass_point_uv), for up to max_lights lights;
+// the draws of further lights take the pass's shared set (pass_point_uv). Open addressing; reset clears only the
+// slots a run used.
+struct light_draw_counts {
+  static constexpr int slots = 256;           // a power of two
+  static constexpr int max_lights = slots / 2;  // (the table at most half full)
+  uint64_t salt = 0;                          // the run's first sample (a later piece of a pass draws new sets)
+  light_draw_counts();
+  void reset(uint64_t run_start);
+  // The draws of `light` counted so far, counting this one; -1 where the table holds max_lights others.
+  int64_t next(int light);
+
+ private:
+  int32_t light_[slots];
+  uint32_t count_[slots];
+  uint16_t used_at_[max_lights];
+  int used_ = 0;
+};
+// The scramble of light `light`'s point set in a pixel's run (pass_hash: the pixel's pass set's, pixel_streams::point).
+uint64_t light_points_hash(uint64_t pass_hash, const light_draw_counts& c, int light);
 
 // Per-tile statistics, point_stat_fields doubles per tile. Samples are weighted by g = 1 / (m^2 + 0.01), m the
 // pixel's luminance mean before the pass (relMSE's weight, SPEC.md §6), and counted only once the pixel has a mean.

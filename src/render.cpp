@@ -216,6 +216,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
             }
             typename Sampler::context ctxs[2];
             std::conditional_t<Profile, cycle_timers, no_timers> tm;
+            light_draw_counts counts;
             for (int x = 0; x < w; x++) {
               double* out = &pass_sum[3 * (size_t(y) * w + x)];
               // (Extended: the sums go on from the pass's earlier samples, added in the order one pass adds them.)
@@ -240,9 +241,11 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                   mean_noise = points->mean_samples / (points->mean_samples + 1);
                 }
                 double block[point_block] = {};
+                counts.reset(uint64_t(s0));
                 for (int s = s0; s < s1; s++) {
                   const uint64_t vertices = st.camera_rays + st.bounce_rays;
                   sample_info info;
+                  info.counts = &counts;
                   vec3f l = trace_path_timed(in, sampler, x, y, ps, uint64_t(s), st, sink, ctxs, tm, &info);
                   sink.sample_done(y * w + x, l);
                   sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;
@@ -442,7 +445,7 @@ void render_with(const render_inputs& in, Sampler& sampler, const render_params&
     if (auto_points) {
       choose_tile_points(result.point_stats, done, pass, pin.nee_samples, tile_points);
       pin.point_tiles = tile_points.data();
-      // (The pass's light-point sets: integrator.h, pass_point_uv.)
+      // (The pass's light-point sets: integrator.h, light_pass_point_uv and pass_point_uv.)
       pin.point_base = uint64_t(done);
       pin.point_key = stratum_key_of(in.seed ^ point_set_seed, uint64_t(done));
       pin.point_tile_cols = tile_cols;

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <set>
+#include <vector>
 
 using namespace bl;
 
@@ -84,6 +85,92 @@ TEST_CASE("a pass's light points: each draw's spread over the light, none repeat
   }
   INFO(paired << " of " << pairs << " draw pairs (1/2, 1/2) apart");
   CHECK(paired < pairs * 3 / 4);
+}
+
+TEST_CASE("a run of a pass counts each light's draws, for up to its capacity of lights", "[light_points]") {
+  light_draw_counts c;
+  c.reset(0);
+  CHECK(c.next(5) == 0);
+  CHECK(c.next(7) == 0);
+  CHECK(c.next(5) == 1);
+  CHECK(c.next(5) == 2);
+  CHECK(c.next(7) == 1);
+  CHECK(c.next(1 << 30) == 0);  // (large ids: the hall's tens of thousands of emitters and more)
+  // A full table: every light it holds goes on counting; a new one takes the pass's shared set (-1).
+  c.reset(0);
+  for (int round = 0; round < 3; round++)
+    for (int l = 0; l < light_draw_counts::max_lights; l++) REQUIRE(c.next(l * 1000 + 3) == round);
+  CHECK(c.next(999999) == -1);
+  CHECK(c.next(3) == 3);
+  // A reset forgets the counts (the next pixel, or the next run of the pass).
+  c.reset(8);
+  CHECK(c.next(3) == 0);
+  CHECK(c.next(999999) == 0);
+}
+
+TEST_CASE("each light's points in a run of a pass are a stratified set of its own", "[light_points]") {
+  // --light-points auto (light_pass_point_uv): three lights chosen in random order, two points a draw. The first 8
+  // points of each light are a (0, 3, 2)-net: one point in each cell of the 8 x 1, 4 x 2, 2 x 4 and 1 x 8 grids of
+  // the light's (u, v) square, however the choices interleave (the pass's shared set, which the draws of all lights
+  // take in turn, gives one light a random subset of its points). The lights' sets, and a later run's, differ.
+  uint64_t state = 23;
+  for (int trial = 0; trial < 100; trial++) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    const uint64_t pass_hash = state ^ (state >> 29);
+    light_draw_counts c;
+    c.reset(uint64_t(trial % 3));
+    std::vector<std::pair<float, float>> pts[3];
+    while (pts[0].size() < 8 || pts[1].size() < 8 || pts[2].size() < 8) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      const int light = int((state >> 33) % 3);
+      const int64_t draw = c.next(light * 17 + 2);
+      REQUIRE(draw >= 0);
+      for (int j = 0; j < 2; j++) {
+        float u, v;
+        light_pass_point_uv(light_points_hash(pass_hash, c, light * 17 + 2), uint32_t(draw), 2, j, u, v);
+        REQUIRE(u >= 0);
+        REQUIRE(u < 1);
+        REQUIRE(v >= 0);
+        REQUIRE(v < 1);
+        pts[light].push_back({u, v});
+      }
+    }
+    for (int light = 0; light < 3; light++)
+      for (int a = 0; a <= 3; a++) {
+        std::set<int> cells;
+        for (size_t i = 0; i < 8; i++)
+          cells.insert(int(pts[light][i].first * float(1 << a)) * 8 + int(pts[light][i].second * float(1 << (3 - a))));
+        INFO("trial " << trial << ", light " << light << ", grid " << (1 << a) << " x " << (1 << (3 - a)));
+        CHECK(cells.size() == 8);
+      }
+    CHECK(pts[0][0] != pts[1][0]);
+    CHECK(pts[1][0] != pts[2][0]);
+    light_draw_counts later;
+    later.reset(100);
+    float u, v;
+    light_pass_point_uv(light_points_hash(pass_hash, later, 2), 0, 2, 0, u, v);
+    CHECK(std::make_pair(u, v) != pts[0][0]);
+  }
+}
+
+TEST_CASE("a light's point in a run of a pass is uniform over its square", "[light_points]") {
+  // Unbiasedness: the c-th point of a light's set, over pixels' scrambles, is uniform, whatever c. Chi-squared over
+  // the 4 x 4 cells of 32000 points (15 degrees of freedom; 37.7 is the 0.1 % quantile), for c = 0, 1, 5 and 77.
+  for (uint32_t draw : {0u, 1u, 5u, 77u}) {
+    int counts[16] = {};
+    const int n = 32000;
+    light_draw_counts c;
+    for (int i = 0; i < n; i++) {
+      c.reset(uint64_t(i));
+      float u, v;
+      light_pass_point_uv(light_points_hash(mix64(uint64_t(i) + 99), c, 4), draw, 3, 1, u, v);
+      counts[int(u * 4) * 4 + int(v * 4)]++;
+    }
+    double chi2 = 0, expected = n / 16.0;
+    for (int k = 0; k < 16; k++) chi2 += (counts[k] - expected) * (counts[k] - expected) / expected;
+    INFO("draw " << draw << ": chi2 " << chi2);
+    CHECK(chi2 < 37.7);
+  }
 }
 
 namespace {
