@@ -76,8 +76,8 @@ struct sample_info {
   // point.
   double within = 0;
   int points = 1;  // light points per draw at the first vertex
-  // Input: the pixel's draws per light so far in this run of the pass (light_pass_point_uv); null: the pass's
-  // shared point set for every draw.
+  // Input: the point sets of the lights the pixel drew so far in this run of the pass (light_pass_point_uv); null:
+  // the pass's shared point set for every draw.
   light_draw_counts* counts = nullptr;
 };
 
@@ -306,9 +306,9 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       st.nee_samples++;
       if (depth == 1) st.first_draws++, st.first_points += uint64_t(points);
       // (Under auto, stratified: the points of this light's own set, light_pass_points; -1: the pass's shared set.)
-      const int64_t light_draw =
-          pass_points && info && info->counts ? info->counts->next(choice.light) : -1;
-      const uint64_t light_hash = light_draw >= 0 ? light_points_hash(ps.point, *info->counts, choice.light) : 0;
+      light_point_set* light_set =
+          pass_points && info && info->counts ? info->counts->set_of(choice.light, point_draw, points) : nullptr;
+      const uint32_t light_draw = light_set ? light_set->draws++ : 0;
       float value = 0, added = 0, added_total = 0;
       vec3f unweighted_sum = {0, 0, 0}, add_sum = {0, 0, 0};
       bool seen = false;  // a point was visible
@@ -316,7 +316,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       for (int j = 0; j < points; j++) {
         t0 = tm.start();
         float u = chosen_points ? point_u : rk->u[dim_light_u], v = chosen_points ? point_v : rk->u[dim_light_v];
-        if (light_draw >= 0) light_pass_point_uv(light_hash, uint32_t(light_draw), points, j, u, v);
+        if (light_set) light_pass_point_uv(*light_set, light_draw, points, j, u, v);
         else if (pass_points) pass_point_uv(ps.point, point_draw, points, j, u, v);
         else if (points > 1) light_point_uv(points, j, u, v);
         light_sample ls = sample_light_point(lights, scene, choice.light, sp.p, u, v);

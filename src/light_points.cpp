@@ -27,39 +27,48 @@ void light_point_uv(int points, int j, float& u, float& v) {
   v = wrap01(v + float(int((int64_t(j) * g) % points)) / float(points));
 }
 
+void pass_point_bits(uint64_t hash, uint64_t draw, int points, int j, uint32_t& a, uint32_t& b) {
+  sobol_pair(uint32_t((draw + 1) * uint64_t(points) + uint64_t(j)), hash, a, b);
+}
+
 void pass_point_uv(uint64_t hash, uint64_t draw, int points, int j, float& u, float& v) {
   uint32_t a, b;
-  sobol_pair(uint32_t((draw + 1) * uint64_t(points) + uint64_t(j)), hash, a, b);
+  pass_point_bits(hash, draw, points, j, a, b);
   u = uint_to_unit(a), v = uint_to_unit(b);
 }
 
-void light_pass_point_uv(uint64_t hash, uint32_t count, int points, int j, float& u, float& v) {
+void light_pass_point_uv(const light_point_set& set, uint32_t draw, int points, int j, float& u, float& v) {
   uint32_t a, b;
-  sobol_pair(count * uint32_t(points) + uint32_t(j), hash, a, b);
-  u = uint_to_unit(a), v = uint_to_unit(b);
-}
-
-uint64_t light_points_hash(uint64_t pass_hash, const light_draw_counts& c, int light) {
-  return mix64(pass_hash ^ c.salt ^ (uint64_t(uint32_t(light)) * 0xd6e8feb86659fd93ull));
+  sobol_pair(draw * uint32_t(points) + uint32_t(j), set.hash, a, b);
+  u = uint_to_unit(a ^ set.shift_a), v = uint_to_unit(b ^ set.shift_b);
 }
 
 light_draw_counts::light_draw_counts() { std::fill(light_, light_ + slots, -1); }
 
-void light_draw_counts::reset(uint64_t run_start) {
+void light_draw_counts::reset(uint64_t pass_hash, uint64_t run_start) {
   for (int i = 0; i < used_; i++) light_[used_at_[i]] = -1;
   used_ = 0;
-  salt = mix64(run_start ^ 0xa54ff53a5f1d36f1ull);
+  pass_hash_ = pass_hash;
+  run_hash_ = mix64(pass_hash ^ mix64(run_start ^ 0xa54ff53a5f1d36f1ull));
 }
 
-int64_t light_draw_counts::next(int light) {
+light_point_set* light_draw_counts::set_of(int light, uint64_t draw, int points) {
   uint32_t i = (uint32_t(light) * 0x9e3779b1u) >> 24;  // (slots = 2^8)
   for (;; i = (i + 1) & (slots - 1)) {
-    if (light_[i] == light) return int64_t(count_[i]++);
+    if (light_[i] == light) return &set_[i];
     if (light_[i] < 0) break;
   }
-  if (used_ == max_lights) return -1;
-  light_[i] = light, count_[i] = 1, used_at_[used_++] = uint16_t(i);
-  return 0;
+  if (used_ == max_lights) return nullptr;
+  light_[i] = light, used_at_[used_++] = uint16_t(i);
+  light_point_set& s = set_[i];
+  s.hash = mix64(run_hash_ ^ (uint64_t(uint32_t(light)) * 0xd6e8feb86659fd93ull));
+  s.draws = 0;
+  // The shift that puts the sequence's point 0 on the shared set's first point of this draw.
+  uint32_t shared_a, shared_b, own_a, own_b;
+  pass_point_bits(pass_hash_, draw, points, 0, shared_a, shared_b);
+  sobol_pair(0, s.hash, own_a, own_b);
+  s.shift_a = shared_a ^ own_a, s.shift_b = shared_b ^ own_b;
+  return &s;
 }
 
 tile_measure measure_tile(const double* s) {

@@ -51,35 +51,46 @@ void light_point_uv(int points, int j, float& u, float& v);
 // [0, 1) in the light set, would otherwise take the two halves of the light as well, a coupling that cost bayes 10 %
 // in the plant room, direct.)
 void pass_point_uv(uint64_t hash, uint64_t draw, int points, int j, float& u, float& v);
+// The same point's 32-bit coordinates (u and v are their top 24 bits).
+void pass_point_bits(uint64_t hash, uint64_t draw, int points, int j, uint32_t& a, uint32_t& b);
 
-// --light-points auto, stratified samples: each light's own point set in a pixel's run of a pass. A draw that
-// chose light L takes, for its K points, points cK .. cK + K - 1 of a scrambled 2D Sobol' sequence of L's own
-// (`hash`: light_points_hash, from the pixel's pass set, L and the run's first sample), c the draws of L before it in
-// the run: the points that fall on one light are a stratified set of their own, however the light choices
-// interleave. Each point stays uniform over the light whatever the earlier choices were (its sequence's scramble is
-// independent of them), so the estimate stays unbiased.
-void light_pass_point_uv(uint64_t hash, uint32_t count, int points, int j, float& u, float& v);
+// --light-points auto, stratified samples: each light's own point set in a pixel's run of a pass. The c-th draw
+// (from 0) of light L in the run takes, for its K points, points cK .. cK + K - 1 of a scrambled 2D Sobol' sequence
+// of L's own, digitally shifted (XOR) so that its first point is the shared set's first point of L's first draw in the
+// run. So the points that fall on one light are a stratified set of their own however the light choices interleave
+// (a digital shift keeps a net a net), and a light drawn once in the run takes the shared set's point, as before:
+// many small lights each drawn about once (a lamp of 450 triangles) keep what the shared set's points, spread jointly
+// with the stratified light choice, gave them. Each point stays uniform over the light whatever the earlier choices
+// were (the shared point is uniform and independent of L's scramble), so the estimate stays unbiased.
+struct light_point_set {
+  uint64_t hash = 0;                 // the sequence's scramble (pixel, pass, run and light)
+  uint32_t shift_a = 0, shift_b = 0; // XORed into its points' 32-bit coordinates
+  uint32_t draws = 0;                // the light's draws in the run so far
+};
+void light_pass_point_uv(const light_point_set& set, uint32_t draw, int points, int j, float& u, float& v);
 
-// The draws of each light so far in one pixel's run of a pass (light_pass_point_uv), for up to max_lights lights;
+// The point sets of the lights one pixel's run of a pass drew (light_pass_point_uv), for up to max_lights lights;
 // the draws of further lights take the pass's shared set (pass_point_uv). Open addressing; reset clears only the
 // slots a run used.
-struct light_draw_counts {
-  static constexpr int slots = 256;           // a power of two
+class light_draw_counts {
+ public:
+  static constexpr int slots = 256;             // a power of two
   static constexpr int max_lights = slots / 2;  // (the table at most half full)
-  uint64_t salt = 0;                          // the run's first sample (a later piece of a pass draws new sets)
   light_draw_counts();
-  void reset(uint64_t run_start);
-  // The draws of `light` counted so far, counting this one; -1 where the table holds max_lights others.
-  int64_t next(int light);
+  // A new run (the next pixel, or a later piece of a pass, which draws new sets): `pass_hash` the pixel's pass set's
+  // scramble (pixel_streams::point), `run_start` the run's first sample.
+  void reset(uint64_t pass_hash, uint64_t run_start);
+  // The set of `light`, made at its first draw, `draw` (the pass's draw number) of `points` points; null where the
+  // table holds max_lights others.
+  light_point_set* set_of(int light, uint64_t draw, int points);
 
  private:
+  uint64_t pass_hash_ = 0, run_hash_ = 0;
   int32_t light_[slots];
-  uint32_t count_[slots];
+  light_point_set set_[slots];
   uint16_t used_at_[max_lights];
   int used_ = 0;
 };
-// The scramble of light `light`'s point set in a pixel's run (pass_hash: the pixel's pass set's, pixel_streams::point).
-uint64_t light_points_hash(uint64_t pass_hash, const light_draw_counts& c, int light);
 
 // Per-tile statistics, point_stat_fields doubles per tile. Samples are weighted by g = 1 / (m^2 + 0.01), m the
 // pixel's luminance mean before the pass (relMSE's weight, SPEC.md §6), and counted only once the pixel has a mean.

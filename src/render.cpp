@@ -241,7 +241,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                   mean_noise = points->mean_samples / (points->mean_samples + 1);
                 }
                 double block[point_block] = {};
-                counts.reset(uint64_t(s0));
+                counts.reset(ps.point, uint64_t(s0));
                 for (int s = s0; s < s1; s++) {
                   const uint64_t vertices = st.camera_rays + st.bounce_rays;
                   sample_info info;

@@ -87,83 +87,123 @@ TEST_CASE("a pass's light points: each draw's spread over the light, none repeat
   CHECK(paired < pairs * 3 / 4);
 }
 
-TEST_CASE("a run of a pass counts each light's draws, for up to its capacity of lights", "[light_points]") {
+TEST_CASE("a run of a pass keeps a point set for each light it draws, up to its capacity of lights", "[light_points]") {
   light_draw_counts c;
-  c.reset(0);
-  CHECK(c.next(5) == 0);
-  CHECK(c.next(7) == 0);
-  CHECK(c.next(5) == 1);
-  CHECK(c.next(5) == 2);
-  CHECK(c.next(7) == 1);
-  CHECK(c.next(1 << 30) == 0);  // (large ids: the hall's tens of thousands of emitters and more)
-  // A full table: every light it holds goes on counting; a new one takes the pass's shared set (-1).
-  c.reset(0);
-  for (int round = 0; round < 3; round++)
-    for (int l = 0; l < light_draw_counts::max_lights; l++) REQUIRE(c.next(l * 1000 + 3) == round);
-  CHECK(c.next(999999) == -1);
-  CHECK(c.next(3) == 3);
-  // A reset forgets the counts (the next pixel, or the next run of the pass).
-  c.reset(8);
-  CHECK(c.next(3) == 0);
-  CHECK(c.next(999999) == 0);
+  c.reset(12345, 0);
+  light_point_set* a = c.set_of(5, 0, 2);
+  REQUIRE(a != nullptr);
+  CHECK(a->draws == 0);
+  a->draws++;
+  light_point_set* b = c.set_of(7, 1, 2);
+  REQUIRE(b != nullptr);
+  CHECK(b != a);
+  CHECK(b->hash != a->hash);
+  CHECK(c.set_of(5, 2, 2) == a);
+  CHECK(a->draws == 1);
+  CHECK(c.set_of(1 << 30, 3, 2) != nullptr);  // (large ids: the hall's tens of thousands of emitters and more)
+  // A full table: every light it holds keeps its set; a new one takes the pass's shared set (null).
+  c.reset(12345, 0);
+  std::vector<light_point_set*> sets;
+  for (int l = 0; l < light_draw_counts::max_lights; l++) sets.push_back(c.set_of(l * 1000 + 3, uint64_t(l), 1));
+  for (int l = 0; l < light_draw_counts::max_lights; l++) {
+    REQUIRE(sets[size_t(l)] != nullptr);
+    CHECK(c.set_of(l * 1000 + 3, 999, 1) == sets[size_t(l)]);
+  }
+  CHECK(c.set_of(999999, 999, 1) == nullptr);
+  // A reset starts new sets (the next pixel, or a later run of the pass: another scramble).
+  const uint64_t first_hash = sets[0]->hash;
+  c.reset(12345, 8);
+  light_point_set* again = c.set_of(3, 0, 1);
+  REQUIRE(again != nullptr);
+  CHECK(again->draws == 0);
+  CHECK(again->hash != first_hash);
+  CHECK(c.set_of(999999, 1, 1) != nullptr);
 }
 
-TEST_CASE("each light's points in a run of a pass are a stratified set of its own", "[light_points]") {
+namespace {
+// Draws a run of a pass from its sample `run_start` (its draws numbered from there): `lights` lights chosen in random
+// order (`state`), `points` points a draw, until each has `per_light` points; returns each light's points in order,
+// and in `first` the shared set's first point of each light's first draw.
+std::vector<std::vector<std::pair<float, float>>> draw_run(uint64_t pass_hash, uint64_t run_start, int lights,
+                                                           int points, size_t per_light, uint64_t& state,
+                                                           std::vector<std::pair<float, float>>& first) {
+  light_draw_counts c;
+  c.reset(pass_hash, run_start);
+  auto pts = std::vector<std::vector<std::pair<float, float>>>(size_t(lights));
+  first.assign(size_t(lights), {-1.0f, -1.0f});
+  for (uint64_t draw = run_start;; draw++) {
+    bool done = true;
+    for (const auto& p : pts) done = done && p.size() >= per_light;
+    if (done) return pts;
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    const int light = int((state >> 33) % uint64_t(lights));
+    light_point_set* set = c.set_of(light * 17 + 2, draw, points);
+    REQUIRE(set != nullptr);
+    const uint32_t d = set->draws++;
+    if (d == 0) pass_point_uv(pass_hash, draw, points, 0, first[size_t(light)].first, first[size_t(light)].second);
+    for (int j = 0; j < points; j++) {
+      float u, v;
+      light_pass_point_uv(*set, d, points, j, u, v);
+      REQUIRE(u >= 0);
+      REQUIRE(u < 1);
+      REQUIRE(v >= 0);
+      REQUIRE(v < 1);
+      pts[size_t(light)].push_back({u, v});
+    }
+  }
+}
+}  // namespace
+
+TEST_CASE("each light's points in a run of a pass are a stratified set of its own, from the shared set's point",
+          "[light_points]") {
   // --light-points auto (light_pass_point_uv): three lights chosen in random order, two points a draw. The first 8
   // points of each light are a (0, 3, 2)-net: one point in each cell of the 8 x 1, 4 x 2, 2 x 4 and 1 x 8 grids of
   // the light's (u, v) square, however the choices interleave (the pass's shared set, which the draws of all lights
-  // take in turn, gives one light a random subset of its points). The lights' sets, and a later run's, differ.
+  // take in turn, gives one light a random subset of its points). Each light's first point is the shared set's
+  // point of its first draw (a light drawn once keeps it). A later run of the pass (its draws numbered on) draws
+  // other points.
   uint64_t state = 23;
   for (int trial = 0; trial < 100; trial++) {
     state = state * 6364136223846793005ull + 1442695040888963407ull;
     const uint64_t pass_hash = state ^ (state >> 29);
-    light_draw_counts c;
-    c.reset(uint64_t(trial % 3));
-    std::vector<std::pair<float, float>> pts[3];
-    while (pts[0].size() < 8 || pts[1].size() < 8 || pts[2].size() < 8) {
-      state = state * 6364136223846793005ull + 1442695040888963407ull;
-      const int light = int((state >> 33) % 3);
-      const int64_t draw = c.next(light * 17 + 2);
-      REQUIRE(draw >= 0);
-      for (int j = 0; j < 2; j++) {
-        float u, v;
-        light_pass_point_uv(light_points_hash(pass_hash, c, light * 17 + 2), uint32_t(draw), 2, j, u, v);
-        REQUIRE(u >= 0);
-        REQUIRE(u < 1);
-        REQUIRE(v >= 0);
-        REQUIRE(v < 1);
-        pts[light].push_back({u, v});
-      }
-    }
-    for (int light = 0; light < 3; light++)
+    std::vector<std::pair<float, float>> first;
+    const auto pts = draw_run(pass_hash, 0, 3, 2, 8, state, first);
+    for (int light = 0; light < 3; light++) {
+      CHECK(pts[size_t(light)][0] == first[size_t(light)]);
       for (int a = 0; a <= 3; a++) {
         std::set<int> cells;
-        for (size_t i = 0; i < 8; i++)
-          cells.insert(int(pts[light][i].first * float(1 << a)) * 8 + int(pts[light][i].second * float(1 << (3 - a))));
+        for (size_t i = 0; i < 8; i++) {
+          const auto& p = pts[size_t(light)][i];
+          cells.insert(int(p.first * float(1 << a)) * 8 + int(p.second * float(1 << (3 - a))));
+        }
         INFO("trial " << trial << ", light " << light << ", grid " << (1 << a) << " x " << (1 << (3 - a)));
         CHECK(cells.size() == 8);
       }
-    CHECK(pts[0][0] != pts[1][0]);
-    CHECK(pts[1][0] != pts[2][0]);
-    light_draw_counts later;
-    later.reset(100);
-    float u, v;
-    light_pass_point_uv(light_points_hash(pass_hash, later, 2), 0, 2, 0, u, v);
-    CHECK(std::make_pair(u, v) != pts[0][0]);
+    }
+    CHECK(pts[0][1] != pts[1][1]);
+    uint64_t state2 = state;
+    std::vector<std::pair<float, float>> first_later;
+    const auto later = draw_run(pass_hash, 100, 3, 2, 8, state2, first_later);
+    CHECK(later[0][0] == first_later[0]);
+    CHECK(later[0][0] != pts[0][0]);
+    CHECK(later[0][2] != pts[0][2]);
   }
 }
 
 TEST_CASE("a light's point in a run of a pass is uniform over its square", "[light_points]") {
-  // Unbiasedness: the c-th point of a light's set, over pixels' scrambles, is uniform, whatever c. Chi-squared over
-  // the 4 x 4 cells of 32000 points (15 degrees of freedom; 37.7 is the 0.1 % quantile), for c = 0, 1, 5 and 77.
+  // Unbiasedness: the c-th draw's point of a light's set, over pixels' scrambles, is uniform, whatever c. Chi-squared
+  // over the 4 x 4 cells of 32000 points (15 degrees of freedom; 37.7 is the 0.1 % quantile), for draws 0, 1, 5 and
+  // 77 of three points (the second point of each).
   for (uint32_t draw : {0u, 1u, 5u, 77u}) {
     int counts[16] = {};
     const int n = 32000;
     light_draw_counts c;
     for (int i = 0; i < n; i++) {
-      c.reset(uint64_t(i));
+      c.reset(mix64(uint64_t(i) + 99), uint64_t(i % 7));
+      light_point_set* set = c.set_of(4, uint64_t(i % 5), 3);
+      REQUIRE(set != nullptr);
       float u, v;
-      light_pass_point_uv(light_points_hash(mix64(uint64_t(i) + 99), c, 4), draw, 3, 1, u, v);
+      light_pass_point_uv(*set, draw, 3, 1, u, v);
       counts[int(u * 4) * 4 + int(v * 4)]++;
     }
     double chi2 = 0, expected = n / 16.0;
