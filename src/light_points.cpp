@@ -83,7 +83,9 @@ tile_measure measure_tile(const double* s) {
     return m;
   // What the pixel's mean keeps of a sample's variance: its samples are a stratified set (the light choice, the camera
   // jitter), which removes much of (y - m)^2 from the mean. Over blocks of point_block consecutive samples from a
-  // multiple of point_block (each a block of the set), sum (y - m)^2 - sum (y - ybar)^2 = b (ybar - m)^2 estimates b
+  // multiple of point_block counted from the light set's start (each a block of that set; blocks counted from sample 0
+  // split the sets of an adaptive sampler, which restart with its model, and so measured more than they keep: HISTORY,
+  // stop 65), sum (y - m)^2 - sum (y - ybar)^2 = b (ybar - m)^2 estimates b
   // Var(ybar) (plus b (m - mu)^2, the earlier mean's own error, small against it): the variance per sample of the
   // blocks' means, whatever the samples' correlation. The Cornell box, direct, measured 0.0032 against (y - m)^2's
   // 0.016 (HISTORY, stop 63). Without enough blocks (a tile of short passes), the sample's own variance.

@@ -102,8 +102,8 @@ enum point_stat_field {
   ps_inv_points,      // sum of 1 / K over those
   ps_within,          // sum of g * sample_info::within over those of K >= 2
   ps_within_samples,  // how many those are
-  ps_block_dev,       // blocks of point_block consecutive samples of a pass (from a multiple of point_block): the sum
-                      // of g (y - m)^2 over their samples
+  ps_block_dev,       // blocks of point_block consecutive samples of a pass (from a multiple of point_block counted from
+                      // the start of the light set, render_inputs::stratum_base): the sum of g (y - m)^2 over them
   ps_block_ss,        // the sum of g times each block's squared deviations from its own mean
   ps_blocks,          // how many blocks
   point_stat_fields

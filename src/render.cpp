@@ -257,8 +257,11 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                     slot[ps_sq_dev] += g * mean_noise * d * d;
                     slot[ps_inv_points] += 1.0 / info.points;
                     if (info.points > 1) slot[ps_within] += g * info.within, slot[ps_within_samples] += 1;
-                    block[s % point_block] = y_lum;
-                    if (s % point_block == point_block - 1 && s - (point_block - 1) >= s0)
+                    // (Blocks of the light set, which starts at stratum_base: an adaptive sampler's restarts
+                    // whenever its model changes, and after bayes's fallback at the fallback.)
+                    const uint64_t b = uint64_t(s) - in.stratum_base;
+                    block[b % point_block] = y_lum;
+                    if (b % point_block == point_block - 1 && s - (point_block - 1) >= s0)
                       add_point_block(slot, block, m, g);
                   }
                 }
