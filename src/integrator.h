@@ -78,7 +78,7 @@ struct sample_info {
   int points = 1;  // light points per draw at the first vertex
   // Input: the point sets of the lights the pixel drew so far in this run of the pass (light_pass_point_uv); null:
   // the pass's shared point set for every draw.
-  light_draw_counts* counts = nullptr;
+  light_point_sets* light_sets = nullptr;
 };
 
 // Counters of one worker's share of a pass (summed in a fixed order afterwards).
@@ -270,7 +270,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
     // stratified light point of a sample depends on the set's earlier points, so a count chosen from their outcomes
     // would bias the estimate (as a model learned from them would: the light sets restart when a model changes). So
     // under auto the points come from sets of the pass's own, one per light a pixel's draws chose (light_pass_point_uv;
-    // past light_draw_counts::max_lights lights in a pixel's pass, one shared by the rest: pass_point_uv), whose
+    // past light_point_sets::max_lights lights in a pixel's pass, one shared by the rest: pass_point_uv), whose
     // counts were chosen before it began (unstratified samples: the sample's own numbers, as a lattice), and MIS
     // weighs them as one point per draw (both sides): given the light chosen, each count then has the same
     // expectation, which no choice of count can tilt. The light choice, the BSDF direction and the camera jitter stay
@@ -305,9 +305,10 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       if constexpr (has_control_variates<Sampler>::value) cv_light = sampler.cv_covers(ctx, choice.cluster);
       st.nee_samples++;
       if (depth == 1) st.first_draws++, st.first_points += uint64_t(points);
-      // (Under auto, stratified: the points of this light's own set, light_pass_points; -1: the pass's shared set.)
-      light_point_set* light_set =
-          pass_points && info && info->counts ? info->counts->set_of(choice.light, point_draw, points) : nullptr;
+      // (Under auto, stratified: the points of this light's own set, light_pass_point_uv; null: the pass's shared set.)
+      light_point_set* light_set = pass_points && info && info->light_sets
+                                       ? info->light_sets->set_of(choice.light, point_draw, points)
+                                       : nullptr;
       const uint32_t light_draw = light_set ? light_set->draws++ : 0;
       float value = 0, added = 0, added_total = 0;
       vec3f unweighted_sum = {0, 0, 0}, add_sum = {0, 0, 0};

@@ -43,16 +43,16 @@ void light_pass_point_uv(const light_point_set& set, uint32_t draw, int points, 
   u = uint_to_unit(a ^ set.shift_a), v = uint_to_unit(b ^ set.shift_b);
 }
 
-light_draw_counts::light_draw_counts() { std::fill(light_, light_ + slots, -1); }
+light_point_sets::light_point_sets() { std::fill(light_, light_ + slots, -1); }
 
-void light_draw_counts::reset(uint64_t pass_hash, uint64_t run_start) {
+void light_point_sets::reset(uint64_t pass_hash, uint64_t run_start) {
   for (int i = 0; i < used_; i++) light_[used_at_[i]] = -1;
   used_ = 0;
   pass_hash_ = pass_hash;
   run_hash_ = mix64(pass_hash ^ mix64(run_start ^ 0xa54ff53a5f1d36f1ull));
 }
 
-light_point_set* light_draw_counts::set_of(int light, uint64_t draw, int points) {
+light_point_set* light_point_sets::set_of(int light, uint64_t draw, int points) {
   uint32_t i = (uint32_t(light) * 0x9e3779b1u) >> 24;  // (slots = 2^8)
   for (;; i = (i + 1) & (slots - 1)) {
     if (light_[i] == light) return &set_[i];

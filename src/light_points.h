@@ -9,9 +9,8 @@
 // a fixed K gives an unbiased estimate; under auto, whose counts depend on a pixel's own earlier samples, the points
 // come from sets of the pass's own, one per light a pixel's draws chose, whose counts were chosen before it began
 // (light_pass_point_uv; unstratified samples: the sample's own numbers), and MIS counts one point per draw
-// (integrator.h), so that the choice of count cannot
-// tilt the estimate either; the statistics are summed in pixel order within a row and in row order
-// within a tile, and are only read between passes.
+// (integrator.h), so that the choice of count cannot tilt the estimate either; the statistics are summed in pixel
+// order within a row and in row order within a tile, and are only read between passes.
 #pragma once
 
 #include <cstddef>
@@ -72,11 +71,11 @@ void light_pass_point_uv(const light_point_set& set, uint32_t draw, int points, 
 // The point sets of the lights one pixel's run of a pass drew (light_pass_point_uv), for up to max_lights lights;
 // the draws of further lights take the pass's shared set (pass_point_uv). Open addressing; reset clears only the
 // slots a run used.
-class light_draw_counts {
+class light_point_sets {
  public:
   static constexpr int slots = 256;             // a power of two
   static constexpr int max_lights = slots / 2;  // (the table at most half full)
-  light_draw_counts();
+  light_point_sets();
   // A new run (the next pixel, or a later piece of a pass, which draws new sets): `pass_hash` the pixel's pass set's
   // scramble (pixel_streams::point), `run_start` the run's first sample.
   void reset(uint64_t pass_hash, uint64_t run_start);
@@ -102,8 +101,8 @@ enum point_stat_field {
   ps_inv_points,      // sum of 1 / K over those
   ps_within,          // sum of g * sample_info::within over those of K >= 2
   ps_within_samples,  // how many those are
-  ps_block_dev,       // blocks of point_block consecutive samples of a pass (from a multiple of point_block counted from
-                      // the start of the light set, render_inputs::stratum_base): the sum of g (y - m)^2 over them
+  ps_block_dev,       // blocks of point_block consecutive samples of a pass (from a multiple of point_block counted
+                      // from the light set's start, render_inputs::stratum_base): the sum of g (y - m)^2 over them
   ps_block_ss,        // the sum of g times each block's squared deviations from its own mean
   ps_blocks,          // how many blocks
   point_stat_fields

@@ -216,7 +216,7 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
             }
             typename Sampler::context ctxs[2];
             std::conditional_t<Profile, cycle_timers, no_timers> tm;
-            light_draw_counts counts;
+            light_point_sets light_sets;
             for (int x = 0; x < w; x++) {
               double* out = &pass_sum[3 * (size_t(y) * w + x)];
               // (Extended: the sums go on from the pass's earlier samples, added in the order one pass adds them.)
@@ -241,11 +241,11 @@ bool run_pass(const render_inputs& in, const Sampler& sampler, int s0, int s1, s
                   mean_noise = points->mean_samples / (points->mean_samples + 1);
                 }
                 double block[point_block] = {};
-                counts.reset(ps.point, uint64_t(s0));
+                light_sets.reset(ps.point, uint64_t(s0));
                 for (int s = s0; s < s1; s++) {
                   const uint64_t vertices = st.camera_rays + st.bounce_rays;
                   sample_info info;
-                  info.counts = &counts;
+                  info.light_sets = &light_sets;
                   vec3f l = trace_path_timed(in, sampler, x, y, ps, uint64_t(s), st, sink, ctxs, tm, &info);
                   sink.sample_done(y * w + x, l);
                   sum[0] += l.x, sum[1] += l.y, sum[2] += l.z;

@@ -88,7 +88,7 @@ TEST_CASE("a pass's light points: each draw's spread over the light, none repeat
 }
 
 TEST_CASE("a run of a pass keeps a point set for each light it draws, up to its capacity of lights", "[light_points]") {
-  light_draw_counts c;
+  light_point_sets c;
   c.reset(12345, 0);
   light_point_set* a = c.set_of(5, 0, 2);
   REQUIRE(a != nullptr);
@@ -104,8 +104,8 @@ TEST_CASE("a run of a pass keeps a point set for each light it draws, up to its 
   // A full table: every light it holds keeps its set; a new one takes the pass's shared set (null).
   c.reset(12345, 0);
   std::vector<light_point_set*> sets;
-  for (int l = 0; l < light_draw_counts::max_lights; l++) sets.push_back(c.set_of(l * 1000 + 3, uint64_t(l), 1));
-  for (int l = 0; l < light_draw_counts::max_lights; l++) {
+  for (int l = 0; l < light_point_sets::max_lights; l++) sets.push_back(c.set_of(l * 1000 + 3, uint64_t(l), 1));
+  for (int l = 0; l < light_point_sets::max_lights; l++) {
     REQUIRE(sets[size_t(l)] != nullptr);
     CHECK(c.set_of(l * 1000 + 3, 999, 1) == sets[size_t(l)]);
   }
@@ -127,7 +127,7 @@ namespace {
 std::vector<std::vector<std::pair<float, float>>> draw_run(uint64_t pass_hash, uint64_t run_start, int lights,
                                                            int points, size_t per_light, uint64_t& state,
                                                            std::vector<std::pair<float, float>>& first) {
-  light_draw_counts c;
+  light_point_sets c;
   c.reset(pass_hash, run_start);
   auto pts = std::vector<std::vector<std::pair<float, float>>>(size_t(lights));
   first.assign(size_t(lights), {-1.0f, -1.0f});
@@ -197,7 +197,7 @@ TEST_CASE("a light's point in a run of a pass is uniform over its square", "[lig
   for (uint32_t draw : {0u, 1u, 5u, 77u}) {
     int counts[16] = {};
     const int n = 32000;
-    light_draw_counts c;
+    light_point_sets c;
     for (int i = 0; i < n; i++) {
       c.reset(mix64(uint64_t(i) + 99), uint64_t(i % 7));
       light_point_set* set = c.set_of(4, uint64_t(i % 5), 3);
