@@ -36,4 +36,11 @@ inline vec3f camera_ray_dir(const camera_data& c, float x, float y) {
   return normalize(c.forward + c.right * sx + c.up * sy);
 }
 
+// The side of a pixel's footprint on a surface at distance t whose geometric normal makes cosine cos_n with the ray:
+// the square root of its area t^2 omega / cos_n, omega the solid angle of a pixel at the image's centre.
+inline float pixel_footprint(const camera_data& c, float t, float cos_n) {
+  float pixel = 2 * std::sqrt(dot(c.up, c.up)) / float(c.height);
+  return t * pixel / std::sqrt(std::max(cos_n, 1e-4f));
+}
+
 }  // namespace bl

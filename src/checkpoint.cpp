@@ -39,7 +39,8 @@ constexpr char magic[16] = {'B', 'A', 'Y', 'E', 'S', 'L', 'I', 'G', 'H', 'T', '-
 // 28: bayes's fallback check also weighs the bvh sampler, and can fall back to it
 // 29: --light-points auto draws each pass's points from a set of its own
 // 30: --light-points auto's tile statistics hold blocks of samples (3 fields more)
-constexpr uint32_t version = 31;  // 31: --light-points auto draws each light's points from a set of its own
+// 31: --light-points auto draws each light's points from a set of its own
+constexpr uint32_t version = 32;  // 32: bayes's first hits choose the coarse region by their pixel footprint
 
 }  // namespace
 
@@ -462,7 +463,7 @@ render_fingerprint_data render_fingerprint(const scene_data& scene, const render
     h.value(r.max_cut), h.value(r.cut_threshold), h.value(r.coherence);
     if (k != sampler_kind::donikian || p.max_depth > 1) {
       h.value(r.grid), h.value(r.shared_cut_lights), h.value(r.min_samples), h.value(r.max_pairs), h.value(r.fine_depth);
-      h.value(r.max_members);
+      h.value(r.max_members), h.value(r.min_pixels);
     }
   }
   h.begin(fp_bayes);

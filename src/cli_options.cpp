@@ -109,6 +109,12 @@ void add_render_options(CLI::App* r, render_options& o) {
                 "NEE samples a fine cell asks for before it gets its own region (default 16; the cells that "
                 "pixel-centre camera rays reach get theirs before the first pass)")
       ->check(CLI::Range(1, 1 << 30))->group(grp);
+  r->add_option("--region-min-pixels", o.regions.min_pixels,
+                "bayes: a first hit uses its fine cell's region only where the cell's side squared is at least this "
+                "many times its pixel's footprint on the surface (distance^2 x the pixel's solid angle / cos), else "
+                "the coarse region: a smaller cell gets under this share of a pixel's samples per spp (default "
+                "0.125; 0: always the fine cell)")
+      ->check(CLI::Range(0.0, 1e6))->group(grp);
   r->add_option("--region-budget", o.regions.max_pairs,
                 "Most (region, cluster) pairs before coarser regions serve (default: bayes 32 per pixel of the "
                 "image, at most 1572864; the others 1572864; at most 2^29)")

@@ -41,7 +41,10 @@ void locate_region(cut_context& ctx, const region_state& regions, const shade_po
   uint64_t key = fine_region_key(regions.grid, sp.p);
   // Deep path vertices are few per cell and scattered: they use (and pool their samples in) coarse regions,
   // whose small table stays in cache.
-  bool coarse = sp.depth > regions.params.fine_depth;
+  // A first hit whose pixel covers more than its fine cell can learn from (bayes: region_params::min_pixels) uses the
+  // coarse region too.
+  bool coarse = sp.depth > regions.params.fine_depth ||
+                (!cut_only && footprint_too_large(regions.params, regions.grid, sp.footprint));
   if (coarse) key = parent_region_key(regions.grid, key, 1);
   // Neighbouring samples often fall in the same cell: reuse the last lookup (regions are frozen during a pass).
   if (key != ctx.fine_key) {

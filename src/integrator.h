@@ -253,6 +253,7 @@ vec3f trace_path_timed(const render_inputs& in, const Sampler& sampler, int x, i
       stratify_sample(ps, sample, in.stratum_base, last, r);
     typename Sampler::context& ctx = ctxs[depth & 1];
     shade_point spt = make_shade_point(sp.p, bsdf, wo, pixel, depth, last);
+    if (depth == 1) spt.footprint = pixel_footprint(in.camera, h.t, std::fabs(dot(scene.tri_ng[h.tri], dir)));
     tm.stop(prof_shading, t0);
     if constexpr (Timers::enabled) {
       // Profiles time the region lookup apart; prepare() then finds it cached.

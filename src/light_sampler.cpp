@@ -16,7 +16,8 @@ namespace {
 
 // Fine region keys of the first hits of rays through every pixel centre (sorted, unique), rows traced in parallel
 // (the sort makes the result independent of the split).
-std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_grid_data& grid) {
+std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_grid_data& grid,
+                                         const region_params& params) {
   int w = in.camera.width, h = in.camera.height;
   std::vector<std::vector<uint64_t>> rows(size_t(std::max(h, 0)));
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& range) {
@@ -28,6 +29,10 @@ std::vector<uint64_t> camera_region_keys(const render_inputs& in, const region_g
         if (hit.tri == invalid_id) continue;
         surface_point sp = eval_surface(*in.scene, hit.tri, hit.b1, hit.b2, hit.p, dir);
         uint64_t key = fine_region_key(grid, sp.p);
+        // (A hit whose pixel footprint is too large for its fine cell asks for the coarse region, as it samples
+        // from that: region_params::min_pixels.)
+        float footprint = pixel_footprint(in.camera, hit.t, std::fabs(dot(in.scene->tri_ng[size_t(hit.tri)], dir)));
+        if (footprint_too_large(params, grid, footprint)) key = parent_region_key(grid, key, 1);
         if (row.empty() || row.back() != key) row.push_back(key);  // neighbours often share a cell
       }
       std::sort(row.begin(), row.end());
@@ -48,7 +53,7 @@ region_state make_regions(const sampler_params& params, const render_inputs& in,
   // The bound sampler reads only cuts: with one cut shared by all regions it needs no region but the root; nor does
   // bayes with one light (bayes_sampler::one_light).
   if (s.shared_cut && (params.kind != sampler_kind::bayes || in.lights->count <= 1)) return s;
-  add_regions(s, tree, camera_region_keys(in, s.grid));
+  add_regions(s, tree, camera_region_keys(in, s.grid, rp));
   return s;
 }
 
@@ -64,6 +69,10 @@ region_params effective_region_params(const sampler_params& params, int max_dept
   // tracing most NEE events are at deep vertices and refined learning costs more time than it saves (README).
   if (rp.max_members < 0) rp.max_members = max_depth == 1 ? region_params::auto_members : 0;
   rp.max_members = members ? std::min(rp.max_members, max_cut_entries - 1) : 0;
+  // The footprint rule is bayes's (bound reads only cuts, which a finer region only sharpens), from 320x240 pixels up:
+  // smaller images have the coarser automatic grid instead, whose cells the rule would send to the coarse regions
+  // nearly everywhere (README, Regions).
+  if (!learned || pixels < region_params::footprint_pixels) rp.min_pixels = 0;
   if (rp.grid < 0) rp.grid = learned ? region_params::auto_grid(pixels) : region_params::default_grid;
   if (rp.max_pairs < 0)
     rp.max_pairs = learned ? std::max<int64_t>(1, std::min(region_params::default_pairs,

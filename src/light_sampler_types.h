@@ -57,6 +57,9 @@ struct shade_point {
   // BSDF over the albedo scale (kd + ks) / pi as gloss_base + gloss_peak cos^ns, cos toward refl (gloss_peak 0: none).
   vec3f refl = {0, 0, 1};
   float ns = 1, gloss_base = 1, gloss_peak = 0;
+  // A first hit: the side of its pixel's footprint on the surface (pixel_footprint), by which bayes may choose the
+  // coarse region (region_params::min_pixels); 0 at deeper vertices.
+  float footprint = 0;
 };
 
 // A chosen light with its selection probability; cluster is the sampler's own bookkeeping (or -1).

@@ -37,6 +37,12 @@ struct region_params {
   static constexpr int auto_members = 128;  // the default in direct illumination (max depth 1); 0 in path tracing
   int min_samples = 16;            // NEE samples a fine cell must ask for before its region is created
   int fine_depth = 1;              // path vertices up to this depth use fine regions, deeper ones coarse regions
+  // bayes: a first hit uses its fine cell only where that cell holds at least this many of its pixel's footprints
+  // (cell side^2 >= min_pixels x footprint^2), else its coarse region: a cell smaller than that receives under
+  // min_pixels of a pixel's samples per spp and learns little (README, Regions). 0: off; the other samplers and
+  // images under footprint_pixels: 0.
+  float min_pixels = 0.125f;
+  static constexpr int64_t footprint_pixels = 320 * 240;  // images below this many pixels: min_pixels 0
   static constexpr int64_t default_pairs = int64_t(3) << 19;  // 1.5 M
   // The command line's default budget (max_pairs -1, resolved by effective_region_params): for bayes at most
   // auto_pairs_per_pixel pairs per pixel of the image, within default_pairs (a render of fewer than 49152 pixels then
@@ -114,6 +120,10 @@ bool shares_one_cut(int triangle_lights, bool has_sun, const region_params& para
 region_state make_region_state(const bbox3f& bounds, const light_tree_data& tree, bool has_sun,
                                const region_params& params);
 
+// Whether a first hit whose pixel footprint has side `footprint` uses the coarse region (region_params::min_pixels).
+inline bool footprint_too_large(const region_params& p, const region_grid_data& g, float footprint) {
+  return p.min_pixels > 0 && p.min_pixels * footprint * footprint > g.cell[0] * g.cell[0];
+}
 // Key of the fine cell containing p.
 uint64_t fine_region_key(const region_grid_data& g, vec3f p);
 // Whether a key is a coarse cell's.

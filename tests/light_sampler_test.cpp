@@ -919,6 +919,68 @@ TEST_CASE("a point whose fine cell has no region uses its coarse cell's region, 
   }
 }
 
+TEST_CASE("a first hit whose pixel footprint outgrows its fine cell uses the coarse region, under bayes only",
+          "[samplers][regions]") {
+  auto t = make_test_scene(true, 320);  // (from 320 x 240 pixels up: region_params::footprint_pixels)
+  sampler_params sp;
+  sp.kind = sampler_kind::bound;
+  sp.regions.shared_cut_lights = 0;
+  light_sampler ls = make_light_sampler(sp, t->in, t->tree);
+  region_state s = std::get<bound_sampler>(ls).regions;
+  CHECK(s.params.min_pixels == 0);  // bound: finer regions only sharpen its cuts
+  const shade_point p = shading_points(*t, 1, 5)[0];
+  const uint64_t k = fine_region_key(s.grid, p.p), coarse = parent_region_key(s.grid, k, 1);
+  add_regions(s, t->tree, {k});
+  REQUIRE(find_region_key(s, k) != invalid_id);
+  REQUIRE(find_region_key(s, coarse) != invalid_id);
+  s.params.min_pixels = 0.125f;
+  // The threshold: a cell side^2 of min_pixels footprints^2.
+  const float edge = s.grid.cell[0] / std::sqrt(s.params.min_pixels);
+  auto at = [&](float footprint, bool cut_only, int depth = 1) {
+    auto ctx = std::make_unique<cut_context>();
+    shade_point q = p;
+    q.footprint = footprint;
+    q.depth = depth;
+    locate_region(*ctx, s, q, cut_only);
+    return ctx->region_key;
+  };
+  CHECK(at(0, false) == k);
+  CHECK(at(0.98f * edge, false) == k);
+  CHECK(at(1.02f * edge, false) == coarse);
+  CHECK(at(1.02f * edge, true) == k);  // a sampler that reads only cuts keeps the fine cell
+  s.params.min_pixels = 0;
+  CHECK(at(1e6f * edge, false) == k);  // off
+  CHECK(footprint_too_large(region_params{}, s.grid, 1.02f * edge));
+  CHECK_FALSE(footprint_too_large(region_params{}, s.grid, 0.98f * edge));
+
+  // The footprint: distance x the pixel's angle (2 tan(fov/2) / height) over sqrt(cos).
+  const camera_data& cam = t->in.camera;
+  const float pixel = 2 * std::tan(0.5f * 50 * pi_f / 180) / float(cam.height);
+  CHECK(pixel_footprint(cam, 3, 1) == Approx(3 * pixel).epsilon(1e-5));
+  CHECK(pixel_footprint(cam, 3, 0.25f) == Approx(6 * pixel).epsilon(1e-5));
+  CHECK(std::isfinite(pixel_footprint(cam, 3, 0)));  // grazing: cos clamped
+
+  // bayes's regions before the first pass: the cells camera rays reach, fine ones only where the footprint allows.
+  auto fine_regions = [&](float min_pixels) {
+    sampler_params b;
+    b.kind = sampler_kind::bayes;
+    b.regions.min_pixels = min_pixels;
+    light_sampler lb = make_light_sampler(b, t->in, t->tree);
+    const region_state& r = std::get<bayes_sampler>(lb).regions;
+    CHECK(r.params.min_pixels == min_pixels);
+    int fine = 0;
+    for (size_t i = 0; i < r.key.size(); i++) fine += int(i) != r.root && !is_coarse_key(r.key[i]);
+    return fine;
+  };
+  CHECK(fine_regions(0) > 0);
+  CHECK(fine_regions(1e6f) == 0);
+  // Below 320 x 240 pixels the automatic grid sizes the cells to the image instead: the rule is off.
+  sampler_params small;
+  small.kind = sampler_kind::bayes;
+  CHECK(effective_region_params(small, 1, 320 * 240).min_pixels == region_params{}.min_pixels);
+  CHECK(effective_region_params(small, 1, 320 * 240 - 1).min_pixels == 0);
+}
+
 TEST_CASE("a scene without any light gives empty light selections", "[samplers]") {
   mesh_builder b;
   int floor = b.add_material({0.5f, 0.5f, 0.5f});
